@@ -1,0 +1,342 @@
+#pragma once
+/// \file constraints/constraint.hpp
+/// Pfaffian (velocity) constraints A(q) q̇ = 0 on a chain of n joints, with a basis S(q) of
+/// the admissible velocities (A S = 0), its derivative Ṡ(q, q̇) and the actuator input map
+/// E(q) (default S):
+///
+///     q̇ = S(q) η,   q̈ = S(q) η̇ + Ṡ(q, q̇) η,   v = E(q) τ + A(q)ᵀ λ        (paper eq. 1–2)
+///
+/// A constraint type provides `dof()` (n), `k()`, `m()` and, templated on the scalar,
+/// `A(q)` (k×n), `S(q)` (n×m), `Sdot(q, qd)` (n×m). Optionally `E(q)` (n×m), and the
+/// structured products `S_times(q, η)`, `St_times(q, v)`, `Sdot_times(q, q̇, η)` that avoid
+/// forming matrices; the free functions below fall back to the dense forms.
+///
+/// Built in: `holonomic` (S = I, k = 0), `differential_drive` (any x, y, heading triple of
+/// joints, forward axis a parameter), `user_constraint` (plain functions of q; Ṡ by duals
+/// when not given).
+#include <functional>
+#include <sstream>
+
+#include "../model/chain.hpp"
+#include "../scalar/dual.hpp"
+
+namespace nhdyn {
+
+template <class S, int R, int C>
+using matrix = Eigen::Matrix<S, R, C>;
+
+/// No constraint: S = I (m = n), A is 0×n.
+template <int N = dynamic>
+struct holonomic {
+  static constexpr int n_at_compile_time = N;
+  static constexpr int k_at_compile_time = N == dynamic ? dynamic : 0;
+  static constexpr int m_at_compile_time = N;
+  int n = N == dynamic ? 0 : N;
+
+  int dof() const { return n; }
+  int k() const { return 0; }
+  int m() const { return n; }
+  template <class Q>
+  auto A(const Eigen::MatrixBase<Q>&) const {
+    return matrix<typename Q::Scalar, k_at_compile_time, N>(0, n);
+  }
+  template <class Q>
+  auto S(const Eigen::MatrixBase<Q>&) const {
+    return matrix<typename Q::Scalar, N, N>::Identity(n, n);
+  }
+  template <class Q, class QD>
+  auto Sdot(const Eigen::MatrixBase<Q>&, const Eigen::MatrixBase<QD>&) const {
+    return matrix<typename Q::Scalar, N, N>::Zero(n, n);
+  }
+  template <class Q, class E>
+  auto S_times(const Eigen::MatrixBase<Q>&, const Eigen::MatrixBase<E>& eta) const {
+    return vecN<typename E::Scalar, N>(eta);
+  }
+  template <class Q, class V>
+  auto St_times(const Eigen::MatrixBase<Q>&, const Eigen::MatrixBase<V>& v) const {
+    return vecN<typename V::Scalar, N>(v);
+  }
+  template <class Q, class QD, class E>
+  auto Sdot_times(const Eigen::MatrixBase<Q>&, const Eigen::MatrixBase<QD>&,
+                  const Eigen::MatrixBase<E>& eta) const {
+    return vecN<typename E::Scalar, N>::Zero(eta.size());
+  }
+  static constexpr bool orthonormal_S = true;  // SᵀS = I: the projection is Sᵀ
+};
+
+/// A differential-drive (unicycle) base: the base point moves only along its forward axis.
+/// Joints x and y translate the base point along two orthogonal ground axes; joint
+/// `heading` turns it. With ψ = heading_sign·q_h + forward_offset the forward axis is
+/// (cos ψ, sin ψ) in (x, y), and
+///
+///     A = −sin ψ at x, cos ψ at y;     η = (v, q̇_j for every other joint j, in order),
+///
+/// v (the forward speed) standing in the place of the first of x, y. paper5:
+/// x = 0 (q₁), y = 1 (q₂), heading = 2, heading_sign = −1, forward_offset = 0.
+template <class Sc = double, int N = dynamic>
+struct differential_drive {
+  static constexpr int n_at_compile_time = N;
+  static constexpr int k_at_compile_time = N == dynamic ? dynamic : 1;
+  static constexpr int m_at_compile_time = N == dynamic ? dynamic : N - 1;
+  static constexpr bool orthonormal_S = true;  // SᵀS = I
+
+  int n = N == dynamic ? 0 : N;
+  int x = 0, y = 1, heading = 2;
+  Sc forward_offset{0};
+  Sc heading_sign{1};
+
+  differential_drive() = default;
+  differential_drive(int n_joints, int x_joint, int y_joint, int heading_joint, Sc offset = Sc(0),
+                     Sc sign = Sc(1))
+      : n(n_joints), x(x_joint), y(y_joint), heading(heading_joint), forward_offset(offset),
+        heading_sign(sign) {
+    validate();
+  }
+
+  void validate() const {
+    std::ostringstream os;
+    if (N != dynamic && n != N) os << "differential_drive: n = " << n << " but the chain has " << N;
+    for (int j : {x, y, heading})
+      if (j < 0 || j >= n) os << "differential_drive: joint index " << j << " outside 0…" << n - 1;
+    if (x == y || x == heading || y == heading)
+      os << "differential_drive: x, y and heading joints must differ (" << x << ", " << y << ", "
+         << heading << ")";
+    const double s = value_of(heading_sign);
+    if (s != 1.0 && s != -1.0) os << "differential_drive: heading_sign must be +1 or −1, not " << s;
+    if (!is_finite_scalar(forward_offset)) os << "differential_drive: forward_offset is not finite";
+    if (!os.str().empty()) throw model_error(os.str());
+  }
+
+  int dof() const { return n; }
+  int k() const { return 1; }
+  int m() const { return n - 1; }
+  int v_slot() const { return std::min(x, y); }
+
+  template <class T>
+  T psi(const T& qh) const {
+    return T(heading_sign) * qh + T(forward_offset);
+  }
+
+  template <class Q>
+  auto A(const Eigen::MatrixBase<Q>& q) const {
+    using T = promote_t<Sc, typename Q::Scalar>;
+    using std::cos;
+    using std::sin;
+    const T p = psi(T(q(heading)));
+    matrix<T, k_at_compile_time, N> a = matrix<T, k_at_compile_time, N>::Zero(1, n);
+    a(0, x) = -sin(p);
+    a(0, y) = cos(p);
+    return a;
+  }
+  template <class Q>
+  auto S(const Eigen::MatrixBase<Q>& q) const {
+    using T = promote_t<Sc, typename Q::Scalar>;
+    matrix<T, N, m_at_compile_time> s = matrix<T, N, m_at_compile_time>::Zero(n, n - 1);
+    for (int c = 0; c < n - 1; ++c) {
+      vecN<T, m_at_compile_time> e = vecN<T, m_at_compile_time>::Zero(n - 1);
+      e(c) = T(1);
+      s.col(c) = S_times(q, e);
+    }
+    return s;
+  }
+  template <class Q, class QD>
+  auto Sdot(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd) const {
+    using T = promote_t<Sc, typename Q::Scalar>;
+    matrix<T, N, m_at_compile_time> s = matrix<T, N, m_at_compile_time>::Zero(n, n - 1);
+    for (int c = 0; c < n - 1; ++c) {
+      vecN<T, m_at_compile_time> e = vecN<T, m_at_compile_time>::Zero(n - 1);
+      e(c) = T(1);
+      s.col(c) = Sdot_times(q, qd, e);
+    }
+    return s;
+  }
+  /// q̇ = S(q) η without forming S.
+  template <class Q, class E>
+  auto S_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta) const {
+    using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename E::Scalar>;
+    using std::cos;
+    using std::sin;
+    vecN<T, N> qd(n);
+    const int lo = std::min(x, y), hi = std::max(x, y);
+    int c = 0;
+    for (int j = 0; j < n; ++j) {
+      if (j == lo) {
+        const T p = psi(T(q(heading)));
+        const T v = T(eta(c++));
+        qd(x) = cos(p) * v;
+        qd(y) = sin(p) * v;
+      } else if (j != hi) {
+        qd(j) = T(eta(c++));
+      }
+    }
+    return qd;
+  }
+  /// Sᵀ v without forming S.
+  template <class Q, class V>
+  auto St_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
+    using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename V::Scalar>;
+    using std::cos;
+    using std::sin;
+    vecN<T, m_at_compile_time> out(n - 1);
+    const int lo = std::min(x, y), hi = std::max(x, y);
+    int c = 0;
+    for (int j = 0; j < n; ++j) {
+      if (j == lo) {
+        const T p = psi(T(q(heading)));
+        out(c++) = cos(p) * T(v(x)) + sin(p) * T(v(y));
+      } else if (j != hi) {
+        out(c++) = T(v(j));
+      }
+    }
+    return out;
+  }
+  /// Ṡ(q, q̇) η without forming Ṡ: only the v column moves, with ψ̇ = heading_sign·q̇_h.
+  template <class Q, class QD, class E>
+  auto Sdot_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
+                  const Eigen::MatrixBase<E>& eta) const {
+    using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename E::Scalar>;
+    using std::cos;
+    using std::sin;
+    vecN<T, N> out = vecN<T, N>::Zero(n);
+    const T p = psi(T(q(heading)));
+    const T pd = T(heading_sign) * T(qd(heading));
+    const T v = T(eta(v_slot()));
+    out(x) = -sin(p) * pd * v;
+    out(y) = cos(p) * pd * v;
+    return out;
+  }
+
+  template <class U>
+  differential_drive<U, N> cast() const {
+    differential_drive<U, N> d;
+    d.n = n;
+    d.x = x;
+    d.y = y;
+    d.heading = heading;
+    d.forward_offset = U(forward_offset);
+    d.heading_sign = U(heading_sign);
+    return d;
+  }
+};
+
+/// A constraint given by plain functions of q (generic lambdas, so that they run on any
+/// scalar): fA(q) → k×n, fS(q) → n×m, optionally fSdot(q, q̇) → n×m and fE(q) → n×m.
+/// Without fSdot, Ṡ = Σ_j ∂S/∂q_j q̇_j is the derivative part of fS at the dual q + ε q̇.
+template <class FA, class FS, class FSdot = std::nullptr_t, class FE = std::nullptr_t>
+struct user_constraint {
+  static constexpr int n_at_compile_time = dynamic;
+  static constexpr int k_at_compile_time = dynamic;
+  static constexpr int m_at_compile_time = dynamic;
+  static constexpr bool orthonormal_S = false;
+  int n_, k_;
+  FA fA;
+  FS fS;
+  FSdot fSdot{};
+  FE fE{};
+
+  int dof() const { return n_; }
+  int k() const { return k_; }
+  int m() const { return n_ - k_; }
+
+  template <class Q>
+  auto A(const Eigen::MatrixBase<Q>& q) const {
+    using T = typename Q::Scalar;
+    matrix<T, dynamic, dynamic> a = fA(vecN<T, dynamic>(q));
+    check(a, k_, n_, "A(q)");
+    return a;
+  }
+  template <class Q>
+  auto S(const Eigen::MatrixBase<Q>& q) const {
+    using T = typename Q::Scalar;
+    matrix<T, dynamic, dynamic> s = fS(vecN<T, dynamic>(q));
+    check(s, n_, n_ - k_, "S(q)");
+    return s;
+  }
+  template <class Q>
+  auto E(const Eigen::MatrixBase<Q>& q) const {
+    using T = typename Q::Scalar;
+    if constexpr (std::is_same_v<FE, std::nullptr_t>) {
+      return S(q);
+    } else {
+      matrix<T, dynamic, dynamic> e = fE(vecN<T, dynamic>(q));
+      check(e, n_, n_ - k_, "E(q)");
+      return e;
+    }
+  }
+  template <class Q, class QD>
+  auto Sdot(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd) const {
+    using T = typename Q::Scalar;
+    if constexpr (!std::is_same_v<FSdot, std::nullptr_t>) {
+      matrix<T, dynamic, dynamic> s = fSdot(vecN<T, dynamic>(q), vecN<T, dynamic>(qd));
+      check(s, n_, n_ - k_, "Sdot(q, qd)");
+      return s;
+    } else {
+      using D = dual<T, 1>;
+      vecN<D, dynamic> qq(q.size());
+      for (Eigen::Index j = 0; j < q.size(); ++j) qq(j) = D(T(q(j)), {T(qd(j))});
+      const matrix<D, dynamic, dynamic> s = fS(qq);
+      check(s, n_, n_ - k_, "S(q)");
+      return matrix<T, dynamic, dynamic>(s.unaryExpr([](const D& d) { return d.derivative(0); }));
+    }
+  }
+
+ private:
+  template <class Mat>
+  static void check(const Mat& a, int r, int c, const char* what) {
+    if (a.rows() != r || a.cols() != c) {
+      std::ostringstream os;
+      os << "user_constraint: " << what << " is " << a.rows() << "×" << a.cols() << ", expected "
+         << r << "×" << c;
+      throw input_error(os.str());
+    }
+  }
+};
+
+/// Builds a user constraint over n joints with k constraint rows.
+template <class FA, class FS>
+auto make_constraint(int n, int k, FA fA, FS fS) {
+  return user_constraint<FA, FS>{n, k, std::move(fA), std::move(fS)};
+}
+template <class FA, class FS, class FSdot>
+auto make_constraint(int n, int k, FA fA, FS fS, FSdot fSdot) {
+  return user_constraint<FA, FS, FSdot>{n, k, std::move(fA), std::move(fS), std::move(fSdot)};
+}
+template <class FA, class FS, class FSdot, class FE>
+auto make_constraint(int n, int k, FA fA, FS fS, FSdot fSdot, FE fE) {
+  return user_constraint<FA, FS, FSdot, FE>{n, k, std::move(fA), std::move(fS), std::move(fSdot),
+                                            std::move(fE)};
+}
+
+// ---- uniform access: structured products where the constraint has them, dense otherwise.
+
+template <class C, class Q>
+auto input_map(const C& c, const Eigen::MatrixBase<Q>& q) {
+  if constexpr (requires { c.E(q); })
+    return c.E(q);
+  else
+    return c.S(q);
+}
+template <class C, class Q, class E>
+auto apply_S(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta) {
+  if constexpr (requires { c.S_times(q, eta); })
+    return c.S_times(q, eta);
+  else
+    return vecN<typename E::Scalar, C::n_at_compile_time>(c.S(q) * eta);
+}
+template <class C, class Q, class V>
+auto apply_St(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) {
+  if constexpr (requires { c.St_times(q, v); })
+    return c.St_times(q, v);
+  else
+    return vecN<typename V::Scalar, C::m_at_compile_time>(c.S(q).transpose() * v);
+}
+template <class C, class Q, class QD, class E>
+auto apply_Sdot(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
+                const Eigen::MatrixBase<E>& eta) {
+  if constexpr (requires { c.Sdot_times(q, qd, eta); })
+    return c.Sdot_times(q, qd, eta);
+  else
+    return vecN<typename E::Scalar, C::n_at_compile_time>(c.Sdot(q, qd) * eta);
+}
+
+}  // namespace nhdyn

@@ -1,0 +1,100 @@
+#pragma once
+/// \file constraints/forward_dynamics.hpp
+/// Constrained (nonholonomic) forward dynamics (paper.md §2):
+///
+///     M_η = Sᵀ M S,   h_η = Sᵀ rne(q, Sη, Ṡη),   M_η η̇ = Sᵀ E τ − h_η
+///
+/// and the state derivative (q̇, η̇) = (S η, η̇) for integrators. M_η is built either from a
+/// composite-rigid-body pass projected by S (default: measured faster, docs/performance.md)
+/// or from m calls of rne with gravity and velocity terms off (q̈ = S e_j).
+#include "../dynamics/mass_matrix.hpp"
+#include "stages.hpp"
+
+namespace nhdyn {
+
+enum class reduced_inertia_method { crba, rne_columns };
+
+template <class S, int N, class C>
+class nh_forward_dynamics_fn : public stage_tag {
+ public:
+  static constexpr int M = C::m_at_compile_time;
+
+  nh_forward_dynamics_fn(const chain<S, N>& ch, C c, rne_options o = {},
+                         reduced_inertia_method method = reduced_inertia_method::crba)
+      : c_(std::move(c)), rne_(ch, o), inertia_rne_(ch, {false, false}), M_(ch), method_(method) {
+    if (c_.dof() != ch.dof())
+      throw model_error("constraint is over " + std::to_string(c_.dof()) + " joints, the chain has " +
+                        std::to_string(ch.dof()));
+  }
+  const C& constraint() const { return c_; }
+
+  /// M_η(q) = Sᵀ M S (m×m).
+  template <class Q>
+  auto reduced_inertia(const Eigen::MatrixBase<Q>& q) const {
+    using T = promote_t<S, typename Q::Scalar>;
+    const int m = c_.m();
+    matrix<T, M, M> Me(m, m);
+    if (method_ == reduced_inertia_method::crba) {
+      const auto Mq = M_(q);
+      const auto Sq = c_.S(q);
+      Me = (Sq.transpose().template cast<T>() * Mq * Sq.template cast<T>());
+    } else {
+      const vecN<T, N> zero = vecN<T, N>::Zero(c_.dof());
+      for (int j = 0; j < m; ++j) {
+        vecN<T, M> e = vecN<T, M>::Zero(m);
+        e(j) = T(1);
+        const vecN<T, N> qdd = apply_S(c_, q, e);
+        Me.col(j) = apply_St(c_, q, inertia_rne_(q, zero, qdd));
+      }
+    }
+    return Me;
+  }
+
+  /// h_η = Sᵀ rne(q, Sη, Ṡη).
+  template <class Q, class E>
+  auto reduced_bias(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta) const {
+    const auto qd = apply_S(c_, q, eta);
+    return apply_St(c_, q, rne_(q, qd, apply_Sdot(c_, q, qd, eta)));
+  }
+
+  /// η̇ = M_η⁻¹ (SᵀE τ − h_η).
+  template <class Q, class E, class TAU>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
+                  const Eigen::MatrixBase<TAU>& tau) const {
+    using T = promote_t<S, typename Q::Scalar>;
+    if constexpr (N == dynamic) {
+      detail::check_size(q, c_.dof(), "q");
+      detail::check_size(eta, c_.m(), "eta");
+      detail::check_size(tau, c_.m(), "tau");
+    }
+    detail::check_finite(tau, "tau");
+    const vecN<T, M> h = reduced_bias(q, eta);
+    vecN<T, M> u;
+    constexpr bool has_E = requires { c_.E(q); };
+    if constexpr (has_E) {
+      u = (c_.S(q).transpose() * c_.E(q)).template cast<T>() * tau.template cast<T>();
+    } else if constexpr (C::orthonormal_S) {
+      u = tau.template cast<T>();
+    } else {
+      const auto Sq = c_.S(q);
+      u = (Sq.transpose() * Sq).template cast<T>() * tau.template cast<T>();
+    }
+    const auto f = ldlt_factor<T, M>(reduced_inertia(q), "the reduced inertia M_η = SᵀMS");
+    return vecN<T, M>(f.solve(u - h));
+  }
+
+ private:
+  C c_;
+  rne_fn<S, N> rne_;
+  rne_fn<S, N> inertia_rne_;
+  mass_matrix_fn<S, N> M_;
+  reduced_inertia_method method_;
+};
+
+template <class S, int N, class C>
+auto nh_forward_dynamics(const chain<S, N>& ch, const C& c, rne_options o = {},
+                         reduced_inertia_method method = reduced_inertia_method::crba) {
+  return nh_forward_dynamics_fn<S, N, C>(ch, c, o, method);
+}
+
+}  // namespace nhdyn

@@ -1,0 +1,156 @@
+#pragma once
+/// \file constraints/stages.hpp
+/// The paper's method as composable stages (paper.md §2, Theorem 1):
+///
+///     lift:     ζ = (q, η, η̇) ↦ ξ = W(q) ζ = (q, S η, S η̇ + Ṡ η)                   (eq. 19)
+///     rne:      ξ ↦ (q, v),  v = rne(q, q̇, q̈)                    (dynamics/rne.hpp)
+///     project:  (q, v) ↦ τ = (Sᵀ E)⁻¹ Sᵀ v   (E = S: (SᵀS)⁻¹Sᵀ v)                  (eq. 18)
+///
+///     nonholonomic inverse dynamics = project ∘ rne ∘ lift   (in the code, literally)
+///
+/// and the constraint forces λ = (A Aᵀ)⁻¹ A (v − E τ), which do no work (q̇ᵀAᵀλ = 0).
+#include "../detail/ldlt.hpp"
+#include "../dynamics/rne.hpp"
+#include "constraint.hpp"
+#include <Eigen/LU>
+
+namespace nhdyn {
+
+template <class C>
+using m_of = std::integral_constant<int, C::m_at_compile_time>;
+
+template <class C>
+class lift_fn : public stage_tag {
+ public:
+  explicit lift_fn(C c) : c_(std::move(c)) {}
+  const C& constraint() const { return c_; }
+
+  /// ξ = (q, Sη, Sη̇ + Ṡη).
+  template <class Q, class E, class ED>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
+                  const Eigen::MatrixBase<ED>& eta_dot) const {
+    constexpr int N = C::n_at_compile_time;
+    if constexpr (N == dynamic) {
+      detail::check_size(q, c_.dof(), "q");
+      detail::check_size(eta, c_.m(), "eta");
+      detail::check_size(eta_dot, c_.m(), "eta_dot");
+    }
+    auto qd = apply_S(c_, q, eta);
+    using T = typename decltype(qd)::Scalar;
+    joint_state<T, N> xi;
+    xi.q = q.template cast<T>();
+    xi.qdd = apply_S(c_, q, eta_dot) + apply_Sdot(c_, q, qd, eta);
+    xi.qd = std::move(qd);
+    return xi;
+  }
+  template <class X, int N, int M>
+  auto operator()(const reduced_state<X, N, M>& z) const {
+    return (*this)(z.q, z.eta, z.eta_dot);
+  }
+
+ private:
+  C c_;
+};
+
+template <class C>
+lift_fn<C> lift(C c) {
+  return lift_fn<C>(std::move(c));
+}
+
+namespace detail {
+/// (SᵀE)⁻¹ r, for any right-hand side r of m entries.
+template <class C, class Q, class R>
+auto solve_StE(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<R>& r) {
+  using T = typename R::Scalar;
+  constexpr int M = C::m_at_compile_time;
+  constexpr bool has_E = requires { c.E(q); };
+  if constexpr (C::orthonormal_S && !has_E) {
+    return vecN<T, M>(r);
+  } else {
+    const auto S = c.S(q);
+    if constexpr (!has_E) {
+      const matrix<T, M, M> G = (S.transpose() * S).template cast<T>();
+      return vecN<T, M>(ldlt_factor<T, M>(G, "SᵀS").solve(r));
+    } else {
+      const matrix<T, M, M> G = (S.transpose() * c.E(q)).template cast<T>();
+      return vecN<T, M>(Eigen::PartialPivLU<matrix<T, M, M>>(G).solve(r));
+    }
+  }
+}
+}  // namespace detail
+
+template <class C>
+class project_fn : public stage_tag {
+ public:
+  explicit project_fn(C c) : c_(std::move(c)) {}
+  const C& constraint() const { return c_; }
+
+  /// τ = (SᵀE)⁻¹ Sᵀ v (m entries).
+  template <class Q, class V>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
+    if constexpr (C::n_at_compile_time == dynamic) detail::check_size(v, c_.dof(), "v");
+    return detail::solve_StE(c_, q, apply_St(c_, q, v));
+  }
+  template <class X, int N>
+  auto operator()(const generalized_forces<X, N>& f) const {
+    return (*this)(f.q, f.v);
+  }
+
+ private:
+  C c_;
+};
+
+template <class C>
+project_fn<C> project(C c) {
+  return project_fn<C>(std::move(c));
+}
+
+/// (q, v) ↦ (τ, λ): the projection and the constraint forces λ = (AAᵀ)⁻¹ A (v − Eτ).
+template <class C>
+class constraint_forces_fn : public stage_tag {
+ public:
+  explicit constraint_forces_fn(C c) : c_(std::move(c)), p_(c_) {}
+
+  template <class Q, class V>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
+    const auto tau = p_(q, v);
+    using T = typename decltype(tau)::Scalar;
+    constexpr int M = C::m_at_compile_time, K = C::k_at_compile_time;
+    constrained_forces<T, M, K> out;
+    const auto A = c_.A(q);
+    const vecN<T, C::n_at_compile_time> r = v.template cast<T>() - (input_map(c_, q) * tau).template cast<T>();
+    const matrix<T, K, K> AAt = (A * A.transpose()).template cast<T>();
+    out.lambda = c_.k() == 0 ? vecN<T, K>(0)
+                             : vecN<T, K>(ldlt_factor<T, K>(AAt, "AAᵀ").solve((A.template cast<T>() * r).eval()));
+    out.tau = tau;
+    return out;
+  }
+  template <class X, int N>
+  auto operator()(const generalized_forces<X, N>& f) const {
+    return (*this)(f.q, f.v);
+  }
+
+ private:
+  C c_;
+  project_fn<C> p_;
+};
+
+template <class C>
+constraint_forces_fn<C> constraint_forces(C c) {
+  return constraint_forces_fn<C>(std::move(c));
+}
+
+/// The nonholonomic inverse dynamics τ(q, η, η̇) = project ∘ rne ∘ lift (Theorem 1).
+/// Call it as `id(q, eta, eta_dot)` or `id(reduced_state{…})`.
+template <class S, int N, class C>
+auto inverse_dynamics(const chain<S, N>& ch, const C& c, rne_options o = {}) {
+  return compose(project(c), rne(ch, o), lift(c));
+}
+
+/// As inverse_dynamics, returning (τ, λ).
+template <class S, int N, class C>
+auto inverse_dynamics_with_forces(const chain<S, N>& ch, const C& c, rne_options o = {}) {
+  return compose(constraint_forces(c), rne(ch, o), lift(c));
+}
+
+}  // namespace nhdyn

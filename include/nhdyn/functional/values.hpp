@@ -1,0 +1,37 @@
+#pragma once
+/// \file functional/values.hpp
+/// The small named values that flow between pipeline stages. Each carries q along so
+/// that a later stage that needs the configuration (a projection) gets it without a
+/// back-channel.
+#include "../model/chain.hpp"
+
+namespace nhdyn {
+
+/// ξ = (q, q̇, q̈): the joint state of the stationary chain (n entries each).
+template <class S, int N = dynamic>
+struct joint_state {
+  vecN<S, N> q, qd, qdd;
+};
+
+/// ζ = (q, η, η̇): configuration and actuator velocities/accelerations (m entries).
+template <class S, int N = dynamic, int M = dynamic>
+struct reduced_state {
+  vecN<S, N> q;
+  vecN<S, M> eta, eta_dot;
+};
+
+/// v, the joint-space generalised forces of the chain at configuration q.
+template <class S, int N = dynamic>
+struct generalized_forces {
+  vecN<S, N> q;
+  vecN<S, N> v;
+};
+
+/// τ (actuator forces, m entries) and λ (constraint forces, k entries) at q.
+template <class S, int M = dynamic, int K = dynamic>
+struct constrained_forces {
+  vecN<S, M> tau;
+  vecN<S, K> lambda;
+};
+
+}  // namespace nhdyn

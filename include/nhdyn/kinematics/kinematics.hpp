@@ -1,0 +1,142 @@
+#pragma once
+/// \file kinematics/kinematics.hpp
+/// Forward kinematics of every link frame, the geometric Jacobian of a point fixed on a
+/// link, and J̇q̇ (that point's velocity-product acceleration), all in frame 0.
+///
+///     X_0i = A_1 ⋯ A_i,  A_i = Rz(θ_i) Tz(d_i) Tx(a_i) Rx(α_i)              (Spong, eq. 3.10)
+///     J = [J_v; J_ω] (6×n), column j ≤ i: revolute (z_{j−1} × (p − o_{j−1}); z_{j−1}),
+///                                      prismatic (z_{j−1}; 0); columns j > i are zero.
+///     [v; ω] = J q̇,   [a; ω̇] = J q̈ + J̇q̇
+#include <vector>
+
+#include "../detail/dh.hpp"
+#include "../detail/small_buffer.hpp"
+
+namespace nhdyn {
+
+/// Pose of frame i in frame 0: R_0i (orientation), p_0i (origin o_i).
+template <class T>
+struct pose {
+  mat3<T> R = mat3<T>::Identity();
+  vec3<T> p = vec3<T>::Zero();
+};
+
+/// Linear and angular velocity-product acceleration of a point: J̇q̇ = (a, ω̇) at q̈ = 0.
+template <class T>
+struct point_acceleration {
+  vec3<T> linear = vec3<T>::Zero();
+  vec3<T> angular = vec3<T>::Zero();
+};
+
+namespace detail {
+template <class T, class S>
+mat3<T> dh_rotation(const dh_link<S>& k, const T& ct, const T& st) {
+  mat3<T> R;
+  R << ct, -st * T(k.ca), st * T(k.sa),  //
+      st, ct * T(k.ca), -ct * T(k.sa),   //
+      T(0), T(k.sa), T(k.ca);
+  return R;
+}
+}  // namespace detail
+
+template <class S, int N = dynamic>
+class kinematics {
+ public:
+  explicit kinematics(const chain<S, N>& c) : links_(detail::make_dh_links(c)), n_(c.dof()) {}
+  int dof() const { return n_; }
+
+  /// Poses of frames 0…n in frame 0 (n+1 entries; entry 0 is the identity).
+  template <class Q>
+  auto forward(const Eigen::MatrixBase<Q>& q) const {
+    using T = promote_t<S, typename Q::Scalar>;
+    if constexpr (N == dynamic) detail::check_size(q, n_, "q");
+    std::vector<pose<T>> X(static_cast<std::size_t>(n_ + 1));
+    for (int i = 0; i < n_; ++i) {
+      const auto& k = links_[std::size_t(i)];
+      const auto [ct, st, d] = detail::geometry(k, T(q(i)));
+      const auto& P = X[std::size_t(i)];
+      X[std::size_t(i + 1)].R = P.R * detail::dh_rotation(k, ct, st);
+      X[std::size_t(i + 1)].p = P.p + P.R * vec3<T>(T(k.a) * ct, T(k.a) * st, d);
+    }
+    return X;
+  }
+
+  /// Pose of frame i (0…n) in frame 0.
+  template <class Q>
+  auto frame(const Eigen::MatrixBase<Q>& q, int i) const {
+    check_link(i, true);
+    return forward(q)[std::size_t(i)];
+  }
+
+  /// Position in frame 0 of the point p_i (given in frame i) of link i (1…n; 0 = base).
+  template <class Q>
+  auto point(const Eigen::MatrixBase<Q>& q, int i, const vec3<S>& p_i = vec3<S>::Zero()) const {
+    using T = promote_t<S, typename Q::Scalar>;
+    const auto X = frame(q, i);
+    return vec3<T>(X.p + X.R * p_i.template cast<T>());
+  }
+
+  /// Geometric Jacobian (6×n, rows v then ω, frame 0) of point p_i of link i.
+  template <class Q>
+  auto jacobian(const Eigen::MatrixBase<Q>& q, int i, const vec3<S>& p_i = vec3<S>::Zero()) const {
+    using T = promote_t<S, typename Q::Scalar>;
+    check_link(i, true);
+    const auto X = forward(q);
+    const vec3<T> p = X[std::size_t(i)].p + X[std::size_t(i)].R * p_i.template cast<T>();
+    Eigen::Matrix<T, 6, N> J = Eigen::Matrix<T, 6, N>::Zero(6, n_);
+    for (int j = 0; j < i; ++j) {
+      const auto& Xj = X[std::size_t(j)];  // frame j−1 of joint j (0-based j)
+      const vec3<T> z = Xj.R.col(2);
+      if (links_[std::size_t(j)].revolute) {
+        J.col(j).template head<3>() = z.cross(p - Xj.p);
+        J.col(j).template tail<3>() = z;
+      } else {
+        J.col(j).template head<3>() = z;
+      }
+    }
+    return J;
+  }
+
+  /// J̇q̇ of point p_i of link i, in frame 0: its acceleration at q̈ = 0, no gravity.
+  template <class Q, class QD>
+  auto jdot_qdot(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, int i,
+                 const vec3<S>& p_i = vec3<S>::Zero()) const {
+    using T = promote_t<S, typename Q::Scalar>;
+    check_link(i, true);
+    if constexpr (N == dynamic) detail::check_size(qd, n_, "qd");
+    vec3<T> w = vec3<T>::Zero(), dw = vec3<T>::Zero(), acc = vec3<T>::Zero();  // frame j
+    mat3<T> R = mat3<T>::Identity();                                          // R_0j
+    for (int j = 0; j < i; ++j) {
+      const auto& k = links_[std::size_t(j)];
+      const auto [ct, st, d] = detail::geometry(k, T(q(j)));
+      const vec3<T> p = detail::offset<T>(k, d);
+      const T qdj = T(qd(j));
+      if (k.revolute) {
+        dw = detail::rot_T(k, ct, st, vec3<T>(dw.x() + w.y() * qdj, dw.y() - w.x() * qdj, dw.z()));
+        w = detail::rot_T(k, ct, st, vec3<T>(w.x(), w.y(), w.z() + qdj));
+        acc = detail::rot_T(k, ct, st, acc) + dw.cross(p) + w.cross(w.cross(p));
+      } else {
+        const vec3<T> z = detail::axis<T>(k);
+        w = detail::rot_T(k, ct, st, w);
+        dw = detail::rot_T(k, ct, st, dw);
+        acc = detail::rot_T(k, ct, st, acc) + dw.cross(p) + w.cross(w.cross(p)) + T(2) * qdj * w.cross(z);
+      }
+      R = R * detail::dh_rotation(k, ct, st);
+    }
+    const vec3<T> r = p_i.template cast<T>();
+    point_acceleration<T> out;
+    out.linear = R * vec3<T>(acc + dw.cross(r) + w.cross(w.cross(r)));
+    out.angular = R * dw;
+    return out;
+  }
+
+ private:
+  void check_link(int i, bool allow_base) const {
+    if (i < (allow_base ? 0 : 1) || i > n_)
+      throw input_error("link index " + std::to_string(i) + " is outside 0…" + std::to_string(n_));
+  }
+  typename detail::dh_links<S, N>::type links_;
+  int n_;
+};
+
+}  // namespace nhdyn

@@ -1,0 +1,90 @@
+#pragma once
+/// \file model/presets.hpp
+/// Ready-made robots.
+///
+/// - `paper5`: the paper's 5-DOF mobile manipulator, exactly as ../shared/spec/paper5.md
+///   pins it down (Table I–II of Salazar-Silva et al.), with its no-lateral-slip constraint.
+///   Parameters are boxes; `paper5_parameters` perturbs them as paper5.md says (a mass
+///   factor scales that link's inertia with it; a length factor scales the DH parameter and
+///   the box edge along it, and the centre of mass and inertia follow).
+/// - `puma560`: the Unimation Puma 560 in standard DH with the rigid-body parameters of
+///   P. Corke's Robotics Toolbox (`mdl_puma560.m`, from Armstrong, Khatib & Burdick 1986),
+///   no motor inertia, gearing or friction. As published, links 1 and 3 violate the
+///   triangle inequality of principal moments, so this preset is built with
+///   `validation.triangle_inequality = false` (see model/chain.hpp).
+#include <numbers>
+
+#include "../constraints/constraint.hpp"
+#include "chain.hpp"
+#include "robot.hpp"
+
+namespace nhdyn::presets {
+
+/// Multipliers on paper5's plant parameters (1 = nominal).
+template <class S = double>
+struct paper5_parameters {
+  std::array<S, 5> mass_factor{S(1), S(1), S(1), S(1), S(1)};  ///< per link (links 1, 2: massless)
+  S d3_factor{1};  ///< d₃ and the platform's height
+  S a4_factor{1};  ///< a₄ and link 4's length
+  S a5_factor{1};  ///< a₅ and link 5's length
+};
+
+/// paper5's chain (5 joints, compile-time sized).
+template <class S = double>
+chain<S, 5> paper5_chain(const paper5_parameters<S>& p = {}) {
+  const S pi = S(std::numbers::pi);
+  const S d3 = S(0.237) * p.d3_factor, a4 = S(0.150) * p.a4_factor, a5 = S(0.168) * p.a5_factor;
+  const S m3 = S(9.0) * p.mass_factor[2], m4 = S(0.1) * p.mass_factor[3], m5 = S(0.1) * p.mass_factor[4];
+  const S w = S(0.050);
+  std::array<link<S>, 5> L{};
+  L[0] = {joint_type::prismatic, -pi / S(2), S(0), S(0), S(0), S(0), vec3<S>::Zero(), mat3<S>::Zero()};
+  L[1] = {joint_type::prismatic, -pi / S(2), S(0), -pi / S(2), S(0), S(0), vec3<S>::Zero(), mat3<S>::Zero()};
+  // Platform: a box 0.445 (x₃, length) × d₃ (y₃, height) × 0.393 (z₃, width); frame 3 on
+  // its top face, so the centre of mass is half the height below it.
+  L[2] = {joint_type::revolute, pi / S(2), S(0), S(0), d3, m3, vec3<S>(S(0), -d3 / S(2), S(0)),
+          box_inertia<S>(m3, S(0.445), d3, S(0.393))};
+  L[3] = {joint_type::revolute, S(0), a4, S(0), S(0), m4, vec3<S>(-a4 / S(2), S(0), S(0)),
+          box_inertia<S>(m4, a4, w, w)};
+  L[4] = {joint_type::revolute, S(0), a5, S(0), S(0), m5, vec3<S>(-a5 / S(2), S(0), S(0)),
+          box_inertia<S>(m5, a5, w, w)};
+  // Links 1 and 2 are massless unless a factor says otherwise (they stay zero).
+  return chain<S, 5>(L, vec3<S>(S(-9.81), S(0), S(0)), "paper5");
+}
+
+/// paper5's constraint: no lateral slip of the base point, η = (v, ω, q̇₄, q̇₅).
+template <class S = double>
+differential_drive<S, 5> paper5_constraint() {
+  return differential_drive<S, 5>(5, 0, 1, 2, S(0), S(-1));
+}
+
+/// The paper's robot: chain and constraint.
+template <class S = double>
+auto paper5(const paper5_parameters<S>& p = {}) {
+  return robot<S, 5, differential_drive<S, 5>>{paper5_chain<S>(p), paper5_constraint<S>()};
+}
+
+/// Corke's standard-DH Puma 560 (6 revolute joints), gravity −9.81 m/s² along z₀.
+template <class S = double>
+chain<S, 6> puma560() {
+  const S pi = S(std::numbers::pi);
+  const auto I = [](double xx, double yy, double zz) {
+    mat3<S> M = mat3<S>::Zero();
+    M(0, 0) = S(xx);
+    M(1, 1) = S(yy);
+    M(2, 2) = S(zz);
+    return M;
+  };
+  const auto c = [](double x, double y, double z) { return vec3<S>(S(x), S(y), S(z)); };
+  const auto R = joint_type::revolute;
+  std::array<link<S>, 6> L{{
+      {R, pi / S(2), S(0), S(0), S(0), S(0), c(0, 0, 0), I(0, 0.35, 0)},
+      {R, S(0), S(0.4318), S(0), S(0), S(17.4), c(-0.3638, 0.006, 0.2275), I(0.13, 0.524, 0.539)},
+      {R, -pi / S(2), S(0.0203), S(0), S(0.15005), S(4.8), c(-0.0203, -0.0141, 0.070), I(0.066, 0.086, 0.0125)},
+      {R, pi / S(2), S(0), S(0), S(0.4318), S(0.82), c(0, 0.019, 0), I(1.8e-3, 1.3e-3, 1.8e-3)},
+      {R, -pi / S(2), S(0), S(0), S(0), S(0.34), c(0, 0, 0), I(0.3e-3, 0.4e-3, 0.3e-3)},
+      {R, S(0), S(0), S(0), S(0), S(0.09), c(0, 0, 0.032), I(0.15e-3, 0.15e-3, 0.04e-3)},
+  }};
+  return chain<S, 6>(L, vec3<S>(S(0), S(0), S(-9.81)), "puma560", validation{false});
+}
+
+}  // namespace nhdyn::presets

@@ -1,0 +1,71 @@
+#pragma once
+/// \file scalar/traits.hpp
+/// What a number type must provide to run nhdyn's algorithms, and the one customisation
+/// point through which the library looks at a generic scalar's value.
+///
+/// A scalar plugs in the way Eigen custom scalars do: arithmetic operators, `sin`/`cos`/
+/// `sqrt` found by argument-dependent lookup (or in `std`), an `Eigen::NumTraits`
+/// specialisation. nhdyn never branches on `a < b` of a generic scalar (an interval's
+/// comparison is not a bool); it branches only on `scalar_traits<S>::value(x)`, a double
+/// that says "roughly where this number is" (midpoint of an interval, real part of a dual).
+#include <cmath>
+#include <concepts>
+#include <type_traits>
+
+namespace nhdyn {
+
+/// Customisation point: specialise for a new number type (see scalar/dual.hpp,
+/// scalar/interval.hpp, scalar/multiprecision.hpp).
+template <class S>
+struct scalar_traits {
+  /// A double that represents x for printing, diagnostics and branching.
+  static double value(const S& x) { return static_cast<double>(x); }
+  /// True only if x is exactly zero in every component (a dual whose derivative is
+  /// non-zero is not zero: a massless link differentiated w.r.t. its mass is not skipped).
+  static bool is_exact_zero(const S& x) { return x == S(0); }
+  /// True if every component of x is finite.
+  static bool is_finite(const S& x) {
+    using std::isfinite;
+    return isfinite(x);
+  }
+};
+
+/// The double value of a scalar: the only way nhdyn looks at a generic scalar.
+template <class S>
+double value_of(const S& x) {
+  return scalar_traits<S>::value(x);
+}
+template <class S>
+bool is_exact_zero(const S& x) {
+  return scalar_traits<S>::is_exact_zero(x);
+}
+template <class S>
+bool is_finite_scalar(const S& x) {
+  return scalar_traits<S>::is_finite(x);
+}
+
+/// What a number type must provide: field arithmetic, construction from double, and the
+/// customisation point above.
+template <class S>
+concept scalar = std::copyable<S> && std::constructible_from<S, double> &&
+                 requires(S a, S b) {
+                   { a + b } -> std::convertible_to<S>;
+                   { a - b } -> std::convertible_to<S>;
+                   { a * b } -> std::convertible_to<S>;
+                   { a / b } -> std::convertible_to<S>;
+                   { -a } -> std::convertible_to<S>;
+                   { value_of(a) } -> std::convertible_to<double>;
+                 };
+
+/// The scalar of a computation that mixes a model scalar M with a state scalar X
+/// (double model with dual state gives dual; interval model with double state gives
+/// interval): the one the other converts to.
+template <class M, class X>
+struct promote {
+  using type = std::conditional_t<std::is_same_v<M, X>, M,
+                                  std::conditional_t<std::is_convertible_v<M, X>, X, M>>;
+};
+template <class M, class X>
+using promote_t = typename promote<M, X>::type;
+
+}  // namespace nhdyn

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Installs everything nhdyn needs to build, test, benchmark and plot, from Debian 12's
+# packages only. Safe to run again; run as root (no sudo needed) or with sudo.
+set -euo pipefail
+pkgs=(
+  build-essential cmake g++ clang-14 libclang-rt-14-dev
+  libeigen3-dev librange-v3-dev catch2 libbenchmark-dev
+  libboost-dev liborocos-kdl-dev nlohmann-json3-dev libsundials-dev
+  gnuplot-nox
+)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+echo "nhdyn: dependencies present"
