@@ -1,0 +1,56 @@
+/// \file fd.cpp
+/// `nhdyn fd`: forward dynamics on JSON lines. Holonomic models: q̈ = M⁻¹(τ − bias)
+/// (forward_dynamics). Models with a constraint: η̇ = M_η⁻¹(SᵀEτ − h_η) (nh_forward_dynamics).
+#include <iostream>
+#include <nhdyn/nhdyn.hpp>
+
+#include "tool.hpp"
+
+namespace nhdyn_tool {
+
+namespace {
+constexpr std::string_view usage = R"(nhdyn fd --model MODEL
+  Forward dynamics. Reads JSON lines on stdin, writes one JSON line per input line.
+  Model without a constraint (n joints):
+    {"q": [n], "qd": [n], "tau": [n]}        ->  {"qdd": [n]}         qdd = M(q)^-1 (tau - bias(q, qd))
+  Model with a constraint (m actuator velocities):
+    {"q": [n], "eta": [m], "tau": [m]}       ->  {"eta_dot": [m]}     eta_dot = M_eta^-1 (S^T E tau - h_eta)
+  A singular or near-singular (reduced) mass matrix is an error line.
+)";
+
+int run(const std::vector<std::string>& args) {
+  const auto o = parse_options(args, {"model"});
+  if (o.help) {
+    std::cout << usage;
+    return 0;
+  }
+  if (!o.positional.empty()) throw usage_error("unexpected argument '" + o.positional[0] + "'");
+  const auto m = load_model_option(o);
+  const auto& ch = m.chain;
+  const int n = ch.dof();
+  if (!m.constraint) {
+    const auto fd = nhdyn::forward_dynamics(ch);
+    return run_lines(std::cin, std::cout, [&](const line& l) {
+      if (l.has("eta"))
+        throw nhdyn::input_error("model '" + ch.name() + "' has no constraint: lines are {\"q\", \"qd\", \"tau\"}");
+      l.expect_keys({"q", "qd", "tau"});
+      const Eigen::VectorXd qdd = fd(l.vector("q", n), l.vector("qd", n), l.vector("tau", n));
+      return ordered_json{{"qdd", to_json(qdd)}};
+    });
+  }
+  const auto& c = *m.constraint;
+  const auto fd = nhdyn::nh_forward_dynamics(ch, c);
+  return run_lines(std::cin, std::cout, [&](const line& l) {
+    if (l.has("qd"))
+      throw nhdyn::input_error("model '" + ch.name() + "' has a constraint: lines are {\"q\", \"eta\", \"tau\"} (eta and tau have " +
+                               std::to_string(c.m()) + " entries)");
+    l.expect_keys({"q", "eta", "tau"});
+    const Eigen::VectorXd eta_dot = fd(l.vector("q", n), l.vector("eta", c.m()), l.vector("tau", c.m()));
+    return ordered_json{{"eta_dot", to_json(eta_dot)}};
+  });
+}
+}  // namespace
+
+command command_fd() { return {"fd", "forward dynamics: (q, qd, tau) -> qdd, or (q, eta, tau) -> eta_dot", usage, run}; }
+
+}  // namespace nhdyn_tool

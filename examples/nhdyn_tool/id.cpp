@@ -1,0 +1,61 @@
+/// \file id.cpp
+/// `nhdyn id`: inverse dynamics on JSON lines. Holonomic models: τ = rne(q, q̇, q̈).
+/// Models with a constraint: (τ, λ) = inverse_dynamics_with_forces(q, η, η̇), i.e. the
+/// projection of rne ∘ lift (paper eqs. 18–19) and λ = (AAᵀ)⁻¹A(v − Eτ).
+#include <iostream>
+#include <nhdyn/nhdyn.hpp>
+
+#include "tool.hpp"
+
+namespace nhdyn_tool {
+
+namespace {
+constexpr std::string_view usage = R"(nhdyn id --model MODEL
+  Inverse dynamics. Reads JSON lines on stdin, writes one JSON line per input line.
+  Model without a constraint (n joints):
+    {"q": [n], "qd": [n], "qdd": [n]}        ->  {"tau": [n]}         tau = rne(q, qd, qdd)
+  Model with a constraint (m = n - k actuator velocities; paper5: eta = (v, omega, qd4, qd5)):
+    {"q": [n], "eta": [m], "eta_dot": [m]}   ->  {"tau": [m], "lambda": [k]}
+  Keys must be exactly those of the model's form; anything else is an error line.
+)";
+
+ordered_json holonomic(const nhdyn::chain<double>& ch, const line& l) {
+  l.expect_keys({"q", "qd", "qdd"});
+  const int n = ch.dof();
+  const Eigen::VectorXd tau = nhdyn::rne(ch)(l.vector("q", n), l.vector("qd", n), l.vector("qdd", n));
+  return {{"tau", to_json(tau)}};
+}
+
+int run(const std::vector<std::string>& args) {
+  const auto o = parse_options(args, {"model"});
+  if (o.help) {
+    std::cout << usage;
+    return 0;
+  }
+  if (!o.positional.empty()) throw usage_error("unexpected argument '" + o.positional[0] + "'");
+  const auto m = load_model_option(o);
+  const auto& ch = m.chain;
+  const int n = ch.dof();
+  if (!m.constraint)
+    return run_lines(std::cin, std::cout, [&](const line& l) {
+      if (l.has("eta") || l.has("eta_dot"))
+        throw nhdyn::input_error("model '" + ch.name() + "' has no constraint: lines are {\"q\", \"qd\", \"qdd\"}");
+      return holonomic(ch, l);
+    });
+  const auto& c = *m.constraint;
+  const auto id = nhdyn::inverse_dynamics_with_forces(ch, c);
+  return run_lines(std::cin, std::cout, [&](const line& l) {
+    if (l.has("qd") || l.has("qdd"))
+      throw nhdyn::input_error("model '" + ch.name() +
+                               "' has a constraint: lines are {\"q\", \"eta\", \"eta_dot\"} (eta has " +
+                               std::to_string(c.m()) + " entries)");
+    l.expect_keys({"q", "eta", "eta_dot"});
+    const auto f = id(l.vector("q", n), l.vector("eta", c.m()), l.vector("eta_dot", c.m()));
+    return ordered_json{{"tau", to_json(Eigen::VectorXd(f.tau))}, {"lambda", to_json(Eigen::VectorXd(f.lambda))}};
+  });
+}
+}  // namespace
+
+command command_id() { return {"id", "inverse dynamics: (q, qd, qdd) -> tau, or (q, eta, eta_dot) -> (tau, lambda)", usage, run}; }
+
+}  // namespace nhdyn_tool

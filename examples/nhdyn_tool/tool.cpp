@@ -1,0 +1,197 @@
+/// \file tool.cpp
+/// The shared parts of the `nhdyn` tool: options, model loading, the line loop.
+#include "tool.hpp"
+
+#include <cmath>
+#include <iostream>
+
+namespace nhdyn_tool {
+
+const std::string& options::required(const std::string& key) const {
+  const auto it = values.find(key);
+  if (it == values.end()) throw usage_error("missing option --" + key);
+  return it->second;
+}
+
+std::string options::get(const std::string& key, const std::string& fallback) const {
+  const auto it = values.find(key);
+  return it == values.end() ? fallback : it->second;
+}
+
+options parse_options(const std::vector<std::string>& args, const std::vector<std::string>& keys,
+                      const std::vector<std::string>& flags) {
+  const auto among = [](const std::vector<std::string>& v, const std::string& k) {
+    return std::find(v.begin(), v.end(), k) != v.end();
+  };
+  options o;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "-h" || a == "--help") {
+      o.help = true;
+    } else if (a.rfind("--", 0) == 0 && a.size() > 2) {
+      std::string key = a.substr(2), value;
+      const auto eq = key.find('=');
+      const bool inline_value = eq != std::string::npos;
+      if (inline_value) {
+        value = key.substr(eq + 1);
+        key = key.substr(0, eq);
+      }
+      if (among(flags, key)) {
+        if (inline_value) throw usage_error("option --" + key + " takes no value");
+        o.values[key] = "1";
+      } else if (among(keys, key)) {
+        if (!inline_value) {
+          if (i + 1 >= args.size()) throw usage_error("option --" + key + " needs a value");
+          value = args[++i];
+        }
+        if (o.values.count(key)) throw usage_error("option --" + key + " given twice");
+        o.values[key] = value;
+      } else {
+        throw usage_error("unknown option --" + key);
+      }
+    } else if (a.size() > 1 && a[0] == '-' && a != "-") {
+      throw usage_error("unknown option " + a);
+    } else {
+      o.positional.push_back(a);
+    }
+  }
+  return o;
+}
+
+nhdyn::io::model<double> load_model_option(const options& o) {
+  return nhdyn::io::load<double>(o.required("model"));
+}
+
+// ---------------------------------------------------------------------------------------
+
+namespace {
+std::string kind(const json& j) { return nhdyn::io::detail::describe(j); }
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "'" : ", '") + x + "'";
+  return s;
+}
+
+double finite_number(const json& j, const std::string& what) {
+  if (!j.is_number()) throw nhdyn::input_error(what + " is a " + kind(j) + ", not a number");
+  const double x = j.get<double>();
+  if (!std::isfinite(x)) throw nhdyn::input_error(what + " is not finite");
+  return x;
+}
+
+/// Throws if an output number is NaN or Inf, naming where it is.
+void check_output(const ordered_json& j, const std::string& path) {
+  if (j.is_number_float()) {
+    if (!std::isfinite(j.get<double>()))
+      throw nhdyn::numerical_error("output " + path + " is not finite (" +
+                                   (std::isnan(j.get<double>()) ? "NaN" : "Inf") +
+                                   "): the input is outside what double precision can compute");
+  } else if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it) check_output(it.value(), path.empty() ? "'" + it.key() + "'" : path + "." + it.key());
+  } else if (j.is_array()) {
+    for (std::size_t i = 0; i < j.size(); ++i) check_output(j[i], path + "[" + std::to_string(i) + "]");
+  }
+}
+}  // namespace
+
+void line::expect_keys(const std::vector<std::string>& keys) const {
+  std::vector<std::string> missing, unknown;
+  for (const auto& k : keys)
+    if (!j_.contains(k)) missing.push_back(k);
+  for (auto it = j_.begin(); it != j_.end(); ++it)
+    if (std::find(keys.begin(), keys.end(), it.key()) == keys.end()) unknown.push_back(it.key());
+  if (missing.empty() && unknown.empty()) return;
+  std::string msg;
+  if (!unknown.empty()) msg += "unknown key(s) " + join(unknown);
+  if (!missing.empty()) msg += (msg.empty() ? "" : "; ") + std::string("missing key(s) ") + join(missing);
+  throw nhdyn::input_error(msg + " (expected exactly " + join(keys) + ")");
+}
+
+Eigen::VectorXd line::vector(std::string_view key, int n) const {
+  const std::string k(key);
+  if (!j_.contains(k)) throw nhdyn::input_error("missing key '" + k + "'");
+  const json& a = j_[k];
+  if (!a.is_array()) throw nhdyn::input_error("'" + k + "' is a " + kind(a) + ", not an array of numbers");
+  if (n >= 0 && a.size() != static_cast<std::size_t>(n))
+    throw nhdyn::input_error("'" + k + "' has " + std::to_string(a.size()) + " entries; the model needs " + std::to_string(n));
+  if (a.empty()) throw nhdyn::input_error("'" + k + "' is empty");
+  Eigen::VectorXd v(static_cast<Eigen::Index>(a.size()));
+  for (std::size_t i = 0; i < a.size(); ++i)
+    v(static_cast<Eigen::Index>(i)) = finite_number(a[i], "'" + k + "'[" + std::to_string(i) + "]");
+  return v;
+}
+
+Eigen::MatrixX2d line::intervals(std::string_view key, int n) const {
+  const std::string k(key);
+  if (!j_.contains(k)) throw nhdyn::input_error("missing key '" + k + "'");
+  const json& a = j_[k];
+  if (!a.is_array()) throw nhdyn::input_error("'" + k + "' is a " + kind(a) + ", not an array of [lo, hi] intervals");
+  if (n >= 0 && a.size() != static_cast<std::size_t>(n))
+    throw nhdyn::input_error("'" + k + "' has " + std::to_string(a.size()) + " intervals; the model needs " + std::to_string(n));
+  Eigen::MatrixX2d m(static_cast<Eigen::Index>(a.size()), 2);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::string w = "'" + k + "'[" + std::to_string(i) + "]";
+    if (!a[i].is_array() || a[i].size() != 2) throw nhdyn::input_error(w + " is not an interval [lo, hi]");
+    const auto r = static_cast<Eigen::Index>(i);
+    m(r, 0) = finite_number(a[i][0], w + "[0]");
+    m(r, 1) = finite_number(a[i][1], w + "[1]");
+    if (m(r, 0) > m(r, 1)) throw nhdyn::input_error(w + " has lo > hi");
+  }
+  return m;
+}
+
+double line::number(std::string_view key) const {
+  const std::string k(key);
+  if (!j_.contains(k)) throw nhdyn::input_error("missing key '" + k + "'");
+  return finite_number(j_[k], "'" + k + "'");
+}
+
+int line::integer(std::string_view key, int max) const {
+  const std::string k(key);
+  if (!j_.contains(k)) throw nhdyn::input_error("missing key '" + k + "'");
+  const json& x = j_[k];
+  if (!x.is_number_integer() || x.get<long long>() < 0 || x.get<long long>() > max)
+    throw nhdyn::input_error("'" + k + "' must be an integer from 0 to " + std::to_string(max));
+  return static_cast<int>(x.get<long long>());
+}
+
+int run_lines(std::istream& in, std::ostream& out, const line_handler& handle) {
+  int status = 0;
+  std::string text;
+  for (long long n = 1; std::getline(in, text); ++n) {
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    const std::string where = "line " + std::to_string(n) + ": ";
+    std::string reply;
+    try {
+      if (text.find_first_not_of(" \t") == std::string::npos)
+        throw nhdyn::input_error("empty line (expected a JSON object)");
+      json j = nhdyn::io::parse_strict<nhdyn::input_error>(text, "");
+      if (!j.is_object()) throw nhdyn::input_error("expected a JSON object, got " + kind(j));
+      const ordered_json result = handle(line(std::move(j)));
+      check_output(result, "");
+      reply = nhdyn::io::dump(result);
+    } catch (const std::exception& e) {
+      std::string msg = e.what();  // a line is one line: its JSON errors need no line number
+      if (const auto p = msg.find("at line 1, column "); p != std::string::npos) msg.replace(p, 18, "at column ");
+      reply = nhdyn::io::dump(ordered_json{{"error", where + msg}});
+      status = 1;
+    }
+    out << reply << '\n' << std::flush;
+  }
+  return status;
+}
+
+ordered_json to_json(const Eigen::VectorXd& v) {
+  ordered_json a = ordered_json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v(i));
+  return a;
+}
+
+ordered_json to_json(const Eigen::MatrixXd& m) {
+  ordered_json a = ordered_json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) a.push_back(to_json(Eigen::VectorXd(m.row(r).transpose())));
+  return a;
+}
+
+}  // namespace nhdyn_tool

@@ -1,0 +1,99 @@
+#pragma once
+/// \file tool.hpp
+/// The `nhdyn` command-line tool's shared parts: the subcommand record, argument parsing,
+/// model loading and the one line-processing loop every line-oriented subcommand uses.
+///
+/// Adding a subcommand: write examples/nhdyn_tool/<name>.cpp defining
+/// `nhdyn_tool::command nhdyn_tool::command_<name>()`, and add `X(<name>)` to the list in
+/// main.cpp. A line-oriented subcommand parses its options with `parse_options`, loads the
+/// model with `load_model_option`, and hands a `line_handler` to `run_lines`.
+#include <Eigen/Core>
+#include <functional>
+#include <iosfwd>
+#include <map>
+#include <nhdyn/io/json.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace nhdyn_tool {
+
+using json = nlohmann::json;                  // an input line, parsed
+using ordered_json = nlohmann::ordered_json;  // an output line, keys in the order written
+
+/// A subcommand: `run` gets the arguments after its name and returns the exit status.
+struct command {
+  std::string_view name;
+  std::string_view summary;  ///< one line, for `nhdyn --help`
+  std::string_view usage;    ///< the full text of `nhdyn <name> --help`
+  int (*run)(const std::vector<std::string>& args);
+};
+
+/// Thrown for a bad command line; main prints it with the usage hint, exit status 2.
+struct usage_error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Parsed command line: `--key value` / `--key=value` options and positional arguments.
+struct options {
+  std::map<std::string, std::string> values;
+  std::vector<std::string> positional;
+  bool help = false;  ///< -h or --help was given
+  /// The value of a required option; throws usage_error if absent.
+  const std::string& required(const std::string& key) const;
+  /// The value of an optional option, or `fallback`.
+  std::string get(const std::string& key, const std::string& fallback) const;
+};
+
+/// Parses args; `keys` are the options taking a value, `flags` those without
+/// (stored with value "1"). Unknown options are a usage_error.
+options parse_options(const std::vector<std::string>& args, const std::vector<std::string>& keys,
+                      const std::vector<std::string>& flags = {});
+
+/// The model named by --model (a preset name or a file path). Throws nhdyn::error with a
+/// message naming the file, link and field.
+nhdyn::io::model<double> load_model_option(const options& o);
+
+// ---------------------------------------------------------------------------------------
+// Lines
+// ---------------------------------------------------------------------------------------
+
+/// One input line's object, with typed accessors that throw nhdyn::input_error naming the
+/// key (e.g. "'q' has 4 entries; the model needs 5").
+class line {
+ public:
+  explicit line(json j) : j_(std::move(j)) {}
+  const json& raw() const { return j_; }
+  bool has(std::string_view key) const { return j_.contains(key); }
+  /// Throws unless the keys are exactly `keys` (naming missing and unknown ones).
+  void expect_keys(const std::vector<std::string>& keys) const;
+  /// A vector of n finite numbers (n < 0: any length ≥ 1).
+  Eigen::VectorXd vector(std::string_view key, int n) const;
+  /// A list of n intervals [lo, hi] with lo ≤ hi, finite, as an n×2 matrix.
+  Eigen::MatrixX2d intervals(std::string_view key, int n) const;
+  /// A finite number.
+  double number(std::string_view key) const;
+  /// A non-negative integer no larger than `max`.
+  int integer(std::string_view key, int max) const;
+
+ private:
+  json j_;
+};
+
+/// Maps one parsed input line to its output object. Throws (any std::exception) to report
+/// the line as an error.
+using line_handler = std::function<ordered_json(const line&)>;
+
+/// The loop of every line-oriented subcommand: reads JSON lines from `in`, writes one line
+/// per input line to `out`, in order, flushed (so the tool can be driven interactively).
+/// A line that is not a JSON object, or whose handler throws, gets {"error": "line N: …"}
+/// and the loop goes on. An empty (or blank) line is an error line too, so input line k is
+/// always output line k. Returns the exit status: 0 if every line succeeded, 1 otherwise.
+int run_lines(std::istream& in, std::ostream& out, const line_handler& handle);
+
+/// JSON helpers for output: arrays of numbers, row-major matrices (printed with 17
+/// significant digits by run_lines; a NaN or Inf makes the line an error naming the key).
+ordered_json to_json(const Eigen::VectorXd& v);
+ordered_json to_json(const Eigen::MatrixXd& m);
+
+}  // namespace nhdyn_tool
