@@ -1,0 +1,362 @@
+// The code snippets of docs/api.md, compiled and checked. Each TEST_CASE holds one snippet
+// (the code between "snippet" and "end snippet" is the code the page shows) followed by
+// checks of what the page claims about it against a relation independent of the code
+// under test: closed forms (planar two-link arm, a pendulum, paper5 with a massless arm),
+// finite differences, hand-written S and Ṡ from paper5.md, power balance.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <nhdyn/nhdyn.hpp>
+#include <numbers>
+#include <string>
+
+namespace {
+
+using vec2 = Eigen::Vector2d;
+using vec4 = Eigen::Vector4d;
+using vec5 = Eigen::Matrix<double, 5, 1>;
+
+// The planar elbow arm of Spong, Hutchinson & Vidyasagar (2006) §7.4.2 in closed form:
+// links of length l, mass m, centre of mass lc from the joint, inertia I about z at the
+// centre of mass, gravity −g along y₀.
+struct planar2 {
+  double l1 = 0.5, l2 = 0.4, m1 = 3.0, m2 = 2.0, w = 0.05, g = 9.81;
+  double lc1() const { return l1 / 2; }
+  double lc2() const { return l2 / 2; }
+  double I1() const { return m1 * (l1 * l1 + w * w) / 12; }  // box about z: m(a² + b²)/12
+  double I2() const { return m2 * (l2 * l2 + w * w) / 12; }
+  Eigen::Matrix2d M(const vec2& q) const {
+    const double c2 = std::cos(q(1));
+    const double d11 = m1 * lc1() * lc1() + m2 * (l1 * l1 + lc2() * lc2() + 2 * l1 * lc2() * c2) + I1() + I2();
+    const double d12 = m2 * (lc2() * lc2() + l1 * lc2() * c2) + I2();
+    const double d22 = m2 * lc2() * lc2() + I2();
+    Eigen::Matrix2d D;
+    D << d11, d12, d12, d22;
+    return D;
+  }
+  vec2 tau(const vec2& q, const vec2& qd, const vec2& qdd) const {
+    const double h = -m2 * l1 * lc2() * std::sin(q(1));
+    const double phi2 = m2 * lc2() * g * std::cos(q(0) + q(1));
+    const double phi1 = (m1 * lc1() + m2 * l1) * g * std::cos(q(0)) + phi2;
+    const vec2 c(2 * h * qd(0) * qd(1) + h * qd(1) * qd(1), -h * qd(0) * qd(0));
+    return M(q) * qdd + c + vec2(phi1, phi2);
+  }
+};
+
+double rel(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return (a - b).norm() / std::max(1.0, b.norm());
+}
+
+}  // namespace
+
+TEST_CASE("docs/api.md §2: a chain built from DH rows and rigid-body parameters gives the closed-form planar-arm dynamics") {
+  const planar2 ref;
+  // snippet
+  using nhdyn::joint_type;
+  const double l1 = 0.5, l2 = 0.4, m1 = 3.0, m2 = 2.0, w = 0.05;
+  std::vector<nhdyn::link<double>> links{
+      // joint, α, a, θ offset, d offset, mass, com (frame i), inertia about com (frame i)
+      {joint_type::revolute, 0, l1, 0, 0, m1, {-l1 / 2, 0, 0}, nhdyn::box_inertia(m1, l1, w, w)},
+      {joint_type::revolute, 0, l2, 0, 0, m2, {-l2 / 2, 0, 0}, nhdyn::box_inertia(m2, l2, w, w)},
+  };
+  const nhdyn::chain<double> arm(links, {0, -9.81, 0}, "planar2");  // run-time size
+  const auto arm2 = arm.fixed<2>();                                 // compile-time size
+
+  const auto id = nhdyn::rne(arm);
+  const Eigen::VectorXd q = vec2(0.3, -0.8), qd = vec2(1.1, -0.4), qdd = vec2(-0.5, 2.0);
+  const Eigen::VectorXd v = id(q, qd, qdd);  // v = M(q)q̈ + C(q, q̇)q̇ + g(q)
+  // end snippet
+  CHECK(rel(v, ref.tau(q, qd, qdd)) < 1e-13);
+  const vec2 v2 = nhdyn::rne(arm2)(vec2(q), vec2(qd), vec2(qdd));
+  CHECK(rel(v2, v) < 1e-15);
+}
+
+TEST_CASE("docs/api.md §2: an unphysical link is refused with a message naming the model, link and field") {
+  // snippet
+  nhdyn::link<double> bad;
+  bad.mass = -1.0;
+  try {
+    nhdyn::chain<double> c({bad}, {0, 0, -9.81}, "oops");
+  } catch (const nhdyn::model_error& e) {
+    // e.what(): "model 'oops', link 1, field 'mass': is negative (-1 kg)"
+    // end snippet
+    CHECK(std::string(e.what()).find("model 'oops', link 1, field 'mass'") != std::string::npos);
+    return;
+  }
+  FAIL("no model_error thrown");
+}
+
+TEST_CASE("docs/api.md §3: rne options drop gravity and velocity terms as the closed form says") {
+  const planar2 ref;
+  const auto arm = nhdyn::chain<double>(
+      {{nhdyn::joint_type::revolute, 0, 0.5, 0, 0, 3.0, {-0.25, 0, 0}, nhdyn::box_inertia(3.0, 0.5, 0.05, 0.05)},
+       {nhdyn::joint_type::revolute, 0, 0.4, 0, 0, 2.0, {-0.2, 0, 0}, nhdyn::box_inertia(2.0, 0.4, 0.05, 0.05)}},
+      {0, -9.81, 0});
+  const vec2 q(0.3, -0.8), qd(1.1, -0.4), qdd(-0.5, 2.0);
+  // snippet
+  const auto id = nhdyn::rne(arm);
+  const auto inertial = id.with({.gravity = false, .velocity = false});  // v = M(q) q̈
+  const auto gravity = nhdyn::rne(arm, {.gravity = true, .velocity = false});
+  const Eigen::VectorXd Mqdd = inertial(q, qd, qdd);
+  const Eigen::VectorXd g = gravity(q, qd, vec2::Zero());  // g(q); q̇ is not read
+  const Eigen::MatrixXd M = nhdyn::mass_matrix(arm)(q);    // CRBA
+  const Eigen::VectorXd h = nhdyn::bias(arm)(q, qd);       // C(q, q̇)q̇ + g(q) = rne(q, q̇, 0)
+  const Eigen::VectorXd qdd_back = nhdyn::forward_dynamics(arm)(q, qd, id(q, qd, qdd));
+  // end snippet
+  CHECK(rel(Mqdd, ref.M(q) * qdd) < 1e-13);
+  CHECK(rel(g, ref.tau(q, vec2::Zero(), vec2::Zero())) < 1e-13);
+  CHECK((M - ref.M(q)).norm() < 1e-13);
+  CHECK(rel(h, ref.tau(q, qd, vec2::Zero())) < 1e-13);
+  CHECK(rel(qdd_back, qdd) < 1e-12);
+}
+
+TEST_CASE("docs/api.md §4: kinematics gives paper5's start tip, and its Jacobian and J̇q̇ match finite differences") {
+  // snippet
+  const auto robot = nhdyn::presets::paper5();
+  const nhdyn::kinematics k(robot.chain);
+  vec5 q;
+  q << -0.23710299623923958, 1.0, std::numbers::pi, 2.058145585963254, 1.2;  // paper5.md's start
+  const Eigen::Vector3d tip = k.point(q, 5);            // origin of frame 5, in frame 0
+  const auto X = k.forward(q);                          // frames 0…5: X[i].R, X[i].p
+  const Eigen::Matrix<double, 6, 5> J = k.jacobian(q, 5);  // [J_v; J_ω], frame 0
+  const vec5 qd(0.2, -0.1, 0.3, 0.5, -0.7);
+  const auto Jdqd = k.jdot_qdot(q, qd, 5);              // .linear, .angular
+  // end snippet
+  CHECK((tip - Eigen::Vector3d(0.35, 1.0, 0.0)).norm() < 1e-9);
+  CHECK((X[5].p - tip).norm() == 0.0);
+  const double h = 1e-6;
+  for (int j = 0; j < 5; ++j) {
+    vec5 dq = vec5::Zero();
+    dq(j) = h;
+    const Eigen::Vector3d fd = (k.point(vec5(q + dq), 5) - k.point(vec5(q - dq), 5)) / (2 * h);
+    CHECK((J.col(j).head<3>() - fd).norm() < 1e-8);
+  }
+  // J̇q̇ = d/dt (J q̇) along q(t) = q + t q̇ with q̇ constant.
+  const Eigen::Matrix<double, 6, 1> fd =
+      (k.jacobian(vec5(q + h * qd), 5) * qd - k.jacobian(vec5(q - h * qd), 5) * qd) / (2 * h);
+  CHECK((Jdqd.linear - fd.head<3>()).norm() < 1e-8);
+  CHECK((Jdqd.angular - fd.tail<3>()).norm() < 1e-8);
+}
+
+TEST_CASE("docs/api.md §5: rne runs on float, long double and duals; the dual derivative matches finite differences") {
+  const auto robot = nhdyn::presets::paper5();
+  const vec5 q(0.3, -0.2, 0.5, 0.8, -1.0), qd(0.4, 0.1, 0.2, 1.0, -0.5), qdd(0.3, -0.2, -0.1, 2.0, 1.0);
+  // snippet
+  const auto id_f = nhdyn::rne(robot.chain.cast<float>());
+  const Eigen::Matrix<float, 5, 1> v_f = id_f(q.cast<float>(), qd.cast<float>(), qdd.cast<float>());
+
+  using D = nhdyn::dual<double, 5>;  // 5 derivative directions, held inline
+  Eigen::Matrix<D, 5, 1> qx;
+  for (int j = 0; j < 5; ++j) qx(j) = D::variable(q(j), j);  // seed ∂/∂q_j
+  const auto v_d = nhdyn::rne(robot.chain)(qx, qd.cast<D>(), qdd.cast<D>());  // model double, state dual
+  // v_d(i).value() = v_i,   v_d(i).derivative(j) = ∂v_i/∂q_j
+  // end snippet
+  const vec5 v = nhdyn::rne(robot.chain)(q, qd, qdd);
+  CHECK((v_f.cast<double>() - v).norm() < 1e-4 * std::max(1.0, v.norm()));
+  const auto id_ld = nhdyn::rne(robot.chain.cast<long double>());
+  const Eigen::Matrix<long double, 5, 1> v_ld =
+      id_ld(q.cast<long double>(), qd.cast<long double>(), qdd.cast<long double>());
+  CHECK((v_ld.cast<double>() - v).norm() < 1e-12 * std::max(1.0, v.norm()));
+  const double h = 1e-6;
+  for (int j = 0; j < 5; ++j) {
+    vec5 dq = vec5::Zero();
+    dq(j) = h;
+    const vec5 fd = (nhdyn::rne(robot.chain)(vec5(q + dq), qd, qdd) - nhdyn::rne(robot.chain)(vec5(q - dq), qd, qdd)) / (2 * h);
+    for (int i = 0; i < 5; ++i) {
+      CHECK(v_d(i).value() == Approx(v(i)).margin(1e-15));
+      CHECK(v_d(i).derivative(j) == Approx(fd(i)).margin(1e-7));
+    }
+  }
+}
+
+TEST_CASE("docs/api.md §6: paper5's constraint has the A and S of paper5.md, A S = 0, and Ṡ matches finite differences") {
+  const vec5 q(0.3, -0.2, 0.7, 0.8, -1.0), qd(0.1, 0.2, -0.6, 0.4, 0.3);
+  // snippet
+  const auto c = nhdyn::presets::paper5_constraint();  // = differential_drive<double,5>(5, 0, 1, 2, 0, −1)
+  const auto A = c.A(q);           // 1×5: [sin q₃, cos q₃, 0, 0, 0]
+  const auto S = c.S(q);           // 5×4
+  const auto Sdot = c.Sdot(q, qd); // 5×4, Ṡ = Σ_j ∂S/∂q_j q̇_j
+  // c.k() = 1, c.m() = 4, c.dof() = 5
+  // end snippet
+  const double s = std::sin(q(2)), co = std::cos(q(2));
+  Eigen::Matrix<double, 1, 5> A_ref;
+  A_ref << s, co, 0, 0, 0;
+  Eigen::Matrix<double, 5, 4> S_ref = Eigen::Matrix<double, 5, 4>::Zero();
+  S_ref(0, 0) = co;
+  S_ref(1, 0) = -s;
+  S_ref(2, 1) = S_ref(3, 2) = S_ref(4, 3) = 1;
+  CHECK((A - A_ref).norm() < 1e-15);
+  CHECK((S - S_ref).norm() < 1e-15);
+  CHECK((A * S).norm() < 1e-15);
+  CHECK(c.k() == 1);
+  CHECK(c.m() == 4);
+  CHECK(c.dof() == 5);
+  const double h = 1e-6;
+  const Eigen::Matrix<double, 5, 4> fd = (c.S(vec5(q + h * qd)) - c.S(vec5(q - h * qd))) / (2 * h);
+  CHECK((Sdot - fd).norm() < 1e-9);
+}
+
+TEST_CASE("docs/api.md §7: the pipeline's τ equals Sᵀ·rne(q, Sη, Sη̇ + Ṡη) with S and Ṡ written by hand") {
+  // snippet
+  const auto robot = nhdyn::presets::paper5();
+  const auto& c = robot.constraint;
+
+  // The three stages, each a function object; compose them either way.
+  const auto lift = nhdyn::lift(c);        // ζ = (q, η, η̇) ↦ ξ = (q, Sη, Sη̇ + Ṡη)   (eq. 19)
+  const auto rne = nhdyn::rne(robot.chain);  // ξ ↦ (q, v)
+  const auto project = nhdyn::project(c);  // (q, v) ↦ τ = (SᵀS)⁻¹Sᵀv               (eq. 18)
+  const auto id_pipe = lift | rne | project;                      // reads as the data flows
+  const auto id_compose = nhdyn::compose(project, rne, lift);     // reads as mathematics
+  const auto id = nhdyn::inverse_dynamics(robot.chain, c);        // the same composition
+
+  const vec5 q(0.3, -0.2, std::numbers::pi / 6, std::numbers::pi / 4, -std::numbers::pi / 3);
+  const vec4 eta(0.5, 0.2, 1.0, -0.5), eta_dot(0.4, -0.1, 2.0, 1.0);  // η = (v, ω, q̇₄, q̇₅)
+  const vec4 tau = id(q, eta, eta_dot);  // (forward force, yaw torque, shoulder, elbow)
+
+  const auto xi = lift(q, eta, eta_dot);  // joint_state: xi.q, xi.qd, xi.qdd
+  const auto f = rne(xi);                 // generalized_forces: f.q, f.v
+  const vec4 tau_staged = project(f);
+  // end snippet
+
+  // Independent: S and Ṡ by hand from paper5.md, the relation of Theorem 1 with SᵀS = I.
+  const double s = std::sin(q(2)), co = std::cos(q(2)), w = eta(1), v = eta(0);
+  Eigen::Matrix<double, 5, 4> S = Eigen::Matrix<double, 5, 4>::Zero(), Sdot = S;
+  S(0, 0) = co;
+  S(1, 0) = -s;
+  S(2, 1) = S(3, 2) = S(4, 3) = 1;
+  Sdot(0, 0) = -s * w;  // d/dt cos q₃, q̇₃ = ω
+  Sdot(1, 0) = -co * w;
+  const vec5 qd = S * eta, qdd = S * eta_dot + Sdot * eta;
+  const vec4 tau_hand = S.transpose() * nhdyn::rne(robot.chain)(q, qd, qdd);
+  CHECK((xi.qd - qd).norm() < 1e-15);
+  CHECK((xi.qdd - qdd).norm() < 1e-15);
+  CHECK((tau - tau_hand).norm() < 1e-13 * tau_hand.norm());
+  CHECK((tau_staged - tau).norm() == 0.0);
+  CHECK((id_pipe(q, eta, eta_dot) - tau).norm() == 0.0);
+  CHECK((id_compose(q, eta, eta_dot) - tau).norm() == 0.0);
+  // Hand check of the lift, as docs/theory.md §7 does it: q̈₁ = v̇ cos q₃ − v ω sin q₃.
+  CHECK(xi.qdd(0) == Approx(eta_dot(0) * co - v * w * s).epsilon(1e-14));
+}
+
+TEST_CASE("docs/api.md §7: with a massless arm, τ and λ are the platform's closed-form forces") {
+  // paper5 with links 4 and 5 massless: the platform (9 kg, centre of mass on the yaw axis)
+  // needs τ = (m v̇, I_yaw ω̇, 0, 0) and a lateral force λ = −m v ω (its centripetal force).
+  nhdyn::presets::paper5_parameters<double> p;
+  p.mass_factor[3] = p.mass_factor[4] = 0.0;
+  const auto robot = nhdyn::presets::paper5(p);
+  const vec5 q(0.3, -0.2, 0.7, 0.8, -1.0);
+  const vec4 eta(0.5, 0.2, 1.0, -0.5), eta_dot(0.4, -0.1, 2.0, 1.0);
+  // snippet
+  const auto with_forces = nhdyn::inverse_dynamics_with_forces(robot.chain, robot.constraint);
+  const auto tl = with_forces(q, eta, eta_dot);  // tl.tau (4), tl.lambda (1)
+  // end snippet
+  const double m = 9.0, I_yaw = m * (0.445 * 0.445 + 0.393 * 0.393) / 12;
+  CHECK(tl.tau(0) == Approx(m * eta_dot(0)).epsilon(1e-13));
+  CHECK(tl.tau(1) == Approx(I_yaw * eta_dot(1)).epsilon(1e-13));
+  CHECK(std::abs(tl.tau(2)) < 1e-14);
+  CHECK(std::abs(tl.tau(3)) < 1e-14);
+  CHECK(tl.lambda(0) == Approx(-m * eta(0) * eta(1)).epsilon(1e-13));
+}
+
+TEST_CASE("docs/api.md §7: a user stage maps wheel speeds in and wheel torques out, conserving power") {
+  const auto robot = nhdyn::presets::paper5();
+  const auto& c = robot.constraint;
+  const vec5 q(0.3, -0.2, 0.7, 0.8, -1.0);
+  // snippet
+  // Wheel radius r and track b: (v, ω) = J (φ̇_R, φ̇_L); wheel torques = Jᵀ (force, yaw torque).
+  const double r = 0.1, b = 0.4;
+  Eigen::Matrix4d J = Eigen::Matrix4d::Identity();
+  J.topLeftCorner<2, 2>() << r / 2, r / 2, r / b, -r / b;
+  const auto wheels_in = nhdyn::stage([J](const vec5& q, const vec4& phi_dot, const vec4& phi_ddot) {
+    return nhdyn::reduced_state<double, 5, 4>{q, J * phi_dot, J * phi_ddot};
+  });
+  const auto wheels_out = nhdyn::stage([J](const vec4& tau) { return vec4(J.transpose() * tau); });
+  const auto id_wheels = wheels_in | nhdyn::lift(c) | nhdyn::rne(robot.chain) | nhdyn::project(c) | wheels_out;
+  const vec4 phi_dot(6.0, 4.0, 1.0, -0.5), phi_ddot(3.0, 5.0, 2.0, 1.0);  // (φ̇_R, φ̇_L, q̇₄, q̇₅)
+  const vec4 wheel_tau = id_wheels(q, phi_dot, phi_ddot);  // (τ_R, τ_L, shoulder, elbow)
+  // end snippet
+  const vec4 eta = J * phi_dot;
+  const vec4 tau = nhdyn::inverse_dynamics(robot.chain, c)(q, eta, vec4(J * phi_ddot));
+  CHECK(eta(0) == Approx(r * (6.0 + 4.0) / 2));
+  CHECK(eta(1) == Approx(r * (6.0 - 4.0) / b));
+  CHECK(wheel_tau.dot(phi_dot) == Approx(tau.dot(eta)).epsilon(1e-13));  // same power
+  CHECK(wheel_tau(0) + wheel_tau(1) == Approx(r * tau(0)).epsilon(1e-13));
+}
+
+TEST_CASE("docs/api.md §6: a user constraint from plain functions gives paper5's τ, with Ṡ by duals") {
+  const auto robot = nhdyn::presets::paper5();
+  const vec5 q0(0.3, -0.2, 0.7, 0.8, -1.0), qd0(0.1, 0.2, -0.6, 0.4, 0.3);
+  // snippet
+  // paper5's constraint written by hand: generic lambdas, so they also run on duals.
+  const auto fA = [](const auto& q) {
+    using T = typename std::decay_t<decltype(q)>::Scalar;
+    using std::cos, std::sin;
+    Eigen::Matrix<T, -1, -1> A = Eigen::Matrix<T, -1, -1>::Zero(1, 5);
+    A(0, 0) = sin(q(2));
+    A(0, 1) = cos(q(2));
+    return A;
+  };
+  const auto fS = [](const auto& q) {
+    using T = typename std::decay_t<decltype(q)>::Scalar;
+    using std::cos, std::sin;
+    Eigen::Matrix<T, -1, -1> S = Eigen::Matrix<T, -1, -1>::Zero(5, 4);
+    S(0, 0) = cos(q(2));
+    S(1, 0) = -sin(q(2));
+    S(2, 1) = S(3, 2) = S(4, 3) = T(1);
+    return S;
+  };
+  const auto c = nhdyn::make_constraint(5, 1, fA, fS);  // n = 5 joints, k = 1 row; Ṡ by duals
+  const auto chain = robot.chain.dynamic_size();       // user constraints are run-time sized
+  const auto id = nhdyn::inverse_dynamics(chain, c);
+  const Eigen::VectorXd q = vec5(0.3, -0.2, 0.7, 0.8, -1.0);
+  const Eigen::VectorXd eta = vec4(0.5, 0.2, 1.0, -0.5), eta_dot = vec4(0.4, -0.1, 2.0, 1.0);
+  const Eigen::VectorXd tau = id(q, eta, eta_dot);
+  // end snippet
+  const vec4 tau_builtin = nhdyn::inverse_dynamics(robot.chain, robot.constraint)(q0, vec4(eta), vec4(eta_dot));
+  CHECK((tau - tau_builtin).norm() < 1e-13 * tau_builtin.norm());
+  Eigen::MatrixXd Sdot_hand = Eigen::MatrixXd::Zero(5, 4);
+  Sdot_hand(0, 0) = -std::sin(q0(2)) * qd0(2);
+  Sdot_hand(1, 0) = -std::cos(q0(2)) * qd0(2);
+  CHECK((c.Sdot(q, Eigen::VectorXd(qd0)) - Sdot_hand).norm() < 1e-15);
+}
+
+TEST_CASE("docs/api.md §8: constrained forward dynamics inverts the inverse dynamics; both ways of building M_η agree") {
+  const vec5 q(0.3, -0.2, 0.7, 0.8, -1.0);
+  const vec4 eta(0.5, 0.2, 1.0, -0.5), eta_dot(0.4, -0.1, 2.0, 1.0);
+  // snippet
+  const auto robot = nhdyn::presets::paper5();
+  const auto fd = nhdyn::nh_forward_dynamics(robot.chain, robot.constraint);  // CRBA projected by S
+  const vec4 tau = nhdyn::inverse_dynamics(robot.chain, robot.constraint)(q, eta, eta_dot);
+  const vec4 eta_dot_back = fd(q, eta, tau);            // η̇ = M_η⁻¹(SᵀS τ − h_η)
+  const Eigen::Matrix4d M_eta = fd.reduced_inertia(q);  // Sᵀ M S
+  const vec4 h_eta = fd.reduced_bias(q, eta);           // Sᵀ rne(q, Sη, Ṡη)
+  const auto fd_cols = nhdyn::nh_forward_dynamics(robot.chain, robot.constraint, {},
+                                                  nhdyn::reduced_inertia_method::rne_columns);
+  const vec5 qdot = nhdyn::apply_S(robot.constraint, q, eta);  // the state derivative (q̇, η̇) = (Sη, η̇)
+  // end snippet
+  CHECK((eta_dot_back - eta_dot).norm() < 1e-10);
+  const auto S = robot.constraint.S(q);
+  CHECK((M_eta - S.transpose() * nhdyn::mass_matrix(robot.chain)(q) * S).norm() < 1e-14);
+  CHECK((fd_cols.reduced_inertia(q) - M_eta).norm() < 1e-13);
+  CHECK((M_eta * eta_dot + h_eta - tau).norm() < 1e-12);
+  CHECK((qdot - S * eta).norm() < 1e-15);
+  // M_η(0, 0) is the whole robot's mass: driving forward moves every link.
+  CHECK(M_eta(0, 0) == Approx(9.2).epsilon(1e-14));
+}
+
+TEST_CASE("docs/api.md §9: wrong sizes and non-finite inputs are errors that say what is wrong") {
+  const auto arm = nhdyn::presets::puma560().dynamic_size();
+  // snippet
+  const auto id = nhdyn::rne(arm);  // arm: presets::puma560().dynamic_size()
+  try {
+    id(Eigen::VectorXd::Zero(5), Eigen::VectorXd::Zero(6), Eigen::VectorXd::Zero(6));
+  } catch (const nhdyn::input_error& e) {
+    // e.what(): "q has 5 entries; the model needs 6"
+    // end snippet
+    CHECK(std::string(e.what()) == "q has 5 entries; the model needs 6");
+  }
+  CHECK_THROWS_AS(id(Eigen::VectorXd::Zero(5), Eigen::VectorXd::Zero(6), Eigen::VectorXd::Zero(6)), nhdyn::input_error);
+  Eigen::VectorXd qd = Eigen::VectorXd::Zero(6);
+  qd(2) = std::nan("");
+  CHECK_THROWS_AS(id(Eigen::VectorXd::Zero(6), qd, Eigen::VectorXd::Zero(6)), nhdyn::error);
+  CHECK_THROWS_WITH(id(Eigen::VectorXd::Zero(6), qd, Eigen::VectorXd::Zero(6)), Catch::Contains("qd[2]"));
+}
