@@ -13,12 +13,23 @@
 ///   triangle inequality of principal moments, so this preset is built with
 ///   `validation.triangle_inequality = false` (see model/chain.hpp).
 #include <numbers>
+#include <type_traits>
 
 #include "../constraints/constraint.hpp"
 #include "chain.hpp"
 #include "robot.hpp"
 
 namespace nhdyn::presets {
+
+/// π in S: to S's own precision for float, double and long double (a double π would
+/// leave a long double model's α = π/2 off by 6e-17).
+template <class S>
+S pi_in() {
+  if constexpr (std::is_floating_point_v<S>)
+    return std::numbers::pi_v<S>;
+  else
+    return S(std::numbers::pi);
+}
 
 /// Multipliers on paper5's plant parameters (1 = nominal).
 template <class S = double>
@@ -32,7 +43,7 @@ struct paper5_parameters {
 /// paper5's chain (5 joints, compile-time sized).
 template <class S = double>
 chain<S, 5> paper5_chain(const paper5_parameters<S>& p = {}) {
-  const S pi = S(std::numbers::pi);
+  const S pi = pi_in<S>();
   const S d3 = S(0.237) * p.d3_factor, a4 = S(0.150) * p.a4_factor, a5 = S(0.168) * p.a5_factor;
   const S m3 = S(9.0) * p.mass_factor[2], m4 = S(0.1) * p.mass_factor[3], m5 = S(0.1) * p.mass_factor[4];
   const S w = S(0.050);
@@ -66,7 +77,7 @@ auto paper5(const paper5_parameters<S>& p = {}) {
 /// Corke's standard-DH Puma 560 (6 revolute joints), gravity −9.81 m/s² along z₀.
 template <class S = double>
 chain<S, 6> puma560() {
-  const S pi = S(std::numbers::pi);
+  const S pi = pi_in<S>();
   const auto I = [](double xx, double yy, double zz) {
     mat3<S> M = mat3<S>::Zero();
     M(0, 0) = S(xx);
