@@ -7,7 +7,10 @@
 #include <cmath>
 #include <nhdyn/nhdyn.hpp>
 #include <numbers>
+#include <random>
 #include <string>
+#include <vector>
+#include <Eigen/Geometry>
 
 namespace {
 
@@ -41,6 +44,54 @@ struct planar2 {
     return M(q) * qdd + c + vec2(phi1, phi2);
   }
 };
+
+// docs/theory.md §3, transcribed from the page with explicit matrices (R_i formed, no
+// shared code with detail::rne_kernel): the forward and backward passes as written there.
+Eigen::VectorXd rne_as_documented(const nhdyn::chain<double>& ch, const Eigen::VectorXd& q,
+                                  const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd, bool gravity) {
+  using Eigen::Matrix3d;
+  using Eigen::Vector3d;
+  const int n = ch.dof();
+  const Vector3d zhat(0, 0, 1);
+  Vector3d w = Vector3d::Zero(), dw = Vector3d::Zero();
+  Vector3d a = gravity ? Vector3d(-ch.gravity()) : Vector3d::Zero();  // a_0 = −g
+  std::vector<Matrix3d> R(n);
+  std::vector<Vector3d> p(n), z(n), F(n), N(n);
+  for (int i = 0; i < n; ++i) {
+    const auto& L = ch[i];
+    const bool rev = L.joint == nhdyn::joint_type::revolute;
+    const double th = L.theta + (rev ? q(i) : 0.0), d = L.d + (rev ? 0.0 : q(i));
+    R[i] = Eigen::AngleAxisd(th, zhat).toRotationMatrix() * Eigen::AngleAxisd(L.alpha, Vector3d::UnitX()).toRotationMatrix();
+    p[i] = Vector3d(L.a, d * std::sin(L.alpha), d * std::cos(L.alpha));
+    z[i] = Vector3d(0, std::sin(L.alpha), std::cos(L.alpha));
+    const Matrix3d Rt = R[i].transpose();
+    if (rev) {
+      dw = Rt * (dw + zhat * qdd(i) + w.cross(zhat * qd(i)));
+      w = Rt * (w + zhat * qd(i));
+      a = Rt * a + dw.cross(p[i]) + w.cross(w.cross(p[i]));
+    } else {
+      w = Rt * w;
+      dw = Rt * dw;
+      a = Rt * a + z[i] * qdd(i) + dw.cross(p[i]) + w.cross(w.cross(p[i])) + 2 * qd(i) * w.cross(z[i]);
+    }
+    const Vector3d h = L.mass * L.com;
+    const Matrix3d Io = L.inertia + L.mass * (L.com.squaredNorm() * Matrix3d::Identity() - L.com * L.com.transpose());
+    F[i] = L.mass * a + dw.cross(h) + w.cross(w.cross(h));
+    N[i] = Io * dw + w.cross(Io * w) + h.cross(a);
+  }
+  Eigen::VectorXd v(n);
+  Vector3d f = Vector3d::Zero(), m = Vector3d::Zero();
+  for (int i = n - 1; i >= 0; --i) {
+    if (i + 1 < n) {
+      f = R[i + 1] * f;
+      m = R[i + 1] * m;
+    }
+    f += F[i];
+    m += p[i].cross(f) + N[i];
+    v(i) = ch[i].joint == nhdyn::joint_type::revolute ? z[i].dot(m) : z[i].dot(f);
+  }
+  return v;
+}
 
 double rel(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return (a - b).norm() / std::max(1.0, b.norm());
@@ -359,4 +410,36 @@ TEST_CASE("docs/api.md §9: wrong sizes and non-finite inputs are errors that sa
   qd(2) = std::nan("");
   CHECK_THROWS_AS(id(Eigen::VectorXd::Zero(6), qd, Eigen::VectorXd::Zero(6)), nhdyn::error);
   CHECK_THROWS_WITH(id(Eigen::VectorXd::Zero(6), qd, Eigen::VectorXd::Zero(6)), Catch::Contains("qd[2]"));
+}
+
+TEST_CASE("docs/theory.md §3: the link-frame recursion as written there reproduces rne on random chains") {
+  std::mt19937 gen(20261121);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int n = 2 + trial % 7;
+    std::vector<nhdyn::link<double>> links(static_cast<std::size_t>(n));
+    for (auto& L : links) {
+      L.joint = u(gen) > 0 ? nhdyn::joint_type::revolute : nhdyn::joint_type::prismatic;
+      L.alpha = 3 * u(gen);
+      L.a = u(gen);
+      L.theta = 3 * u(gen);
+      L.d = u(gen);
+      L.mass = 1.5 + u(gen);
+      L.com = Eigen::Vector3d(u(gen), u(gen), u(gen)) * 0.3;
+      const Eigen::Matrix3d Rr = Eigen::Quaterniond(Eigen::Vector4d(u(gen), u(gen), u(gen), u(gen)).normalized()).toRotationMatrix();
+      L.inertia = Rr * nhdyn::box_inertia(L.mass, 1.2 + u(gen), 1.2 + u(gen), 1.2 + u(gen)) * Rr.transpose();
+    }
+    if (trial % 5 == 0) links[1].mass = 0, links[1].com.setZero(), links[1].inertia.setZero();  // skipped link
+    const nhdyn::chain<double> ch(links, Eigen::Vector3d(u(gen), u(gen), -9.81), "random");
+    Eigen::VectorXd q(n), qd(n), qdd(n);
+    for (int i = 0; i < n; ++i) q(i) = 2 * u(gen), qd(i) = 2 * u(gen), qdd(i) = 2 * u(gen);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+    const Eigen::VectorXd v = nhdyn::rne(ch)(q, qd, qdd);
+    CHECK(rel(v, rne_as_documented(ch, q, qd, qdd, true)) < 1e-13);
+    // velocity = false: the same recursion with q̇ = 0 (ω ≡ 0); gravity = false: a_0 = 0.
+    CHECK(rel(nhdyn::rne(ch, {.gravity = true, .velocity = false})(q, qd, qdd), rne_as_documented(ch, q, zero, qdd, true)) < 1e-13);
+    CHECK(rel(nhdyn::rne(ch, {.gravity = false, .velocity = true})(q, qd, qdd), rne_as_documented(ch, q, qd, qdd, false)) < 1e-13);
+    // (★) of theory.md §3: rne(q, q̇, q̈) = M(q) q̈ + rne(q, q̇, 0).
+    CHECK(rel(v, nhdyn::mass_matrix(ch)(q) * qdd + nhdyn::rne(ch)(q, qd, zero)) < 1e-12);
+  }
 }
