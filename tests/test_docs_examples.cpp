@@ -5,6 +5,7 @@
 // finite differences, hand-written S and Ṡ from paper5.md, power balance.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <nhdyn/io/json.hpp>
 #include <nhdyn/nhdyn.hpp>
 #include <numbers>
 #include <random>
@@ -441,5 +442,36 @@ TEST_CASE("docs/theory.md §3: the link-frame recursion as written there reprodu
     CHECK(rel(nhdyn::rne(ch, {.gravity = false, .velocity = true})(q, qd, qdd), rne_as_documented(ch, q, qd, qdd, false)) < 1e-13);
     // (★) of theory.md §3: rne(q, q̇, q̈) = M(q) q̈ + rne(q, q̇, 0).
     CHECK(rel(v, nhdyn::mass_matrix(ch)(q) * qdd + nhdyn::rne(ch)(q, qd, zero)) < 1e-12);
+  }
+}
+
+TEST_CASE("docs/api.md §2: a model read from JSON text gives the pendulum's closed form, and errors name the link and field") {
+  // snippet
+  // #include <nhdyn/io/json.hpp>  (needs nlohmann-json3-dev)
+  const std::string text = R"({"name": "pendulum", "gravity": [0, -9.81, 0],
+    "links": [{"joint": "revolute", "alpha": 0, "a": 0.7, "theta": 0, "d": 0, "mass": 2,
+               "com": [0, 0, 0], "inertia": [[0, 0, 0], [0, 0, 0], [0, 0, 0]]}]})";
+  const nhdyn::io::model<double> m = nhdyn::io::parse_model(text, "inline");
+  // m.chain: chain<double> (run-time size); m.constraint: std::optional<differential_drive<double>>
+  const Eigen::VectorXd v = nhdyn::rne(m.chain)(Eigen::VectorXd::Constant(1, 0.4), Eigen::VectorXd::Constant(1, -1.3),
+                                                Eigen::VectorXd::Constant(1, 0.9));
+  const auto p5 = nhdyn::io::load("paper5");  // a preset name, or a file: io::load("examples/paper5.json")
+  // end snippet
+  // A point mass m at the tip of a massless rod l: τ = m l² q̈ + m g l cos q.
+  CHECK(v(0) == Approx(2 * 0.7 * 0.7 * 0.9 + 2 * 9.81 * 0.7 * std::cos(0.4)).epsilon(1e-14));
+  CHECK(!m.constraint.has_value());
+  REQUIRE(p5.constraint.has_value());
+  const vec5 q(0.3, -0.2, 0.7, 0.8, -1.0), qd(0.1, 0.2, -0.6, 0.4, 0.3), qdd(0.5, -0.4, 0.2, 1.0, -2.0);
+  const auto robot = nhdyn::presets::paper5();
+  const Eigen::VectorXd v5 = nhdyn::rne(p5.chain)(Eigen::VectorXd(q), Eigen::VectorXd(qd), Eigen::VectorXd(qdd));
+  CHECK(rel(v5, nhdyn::rne(robot.chain)(q, qd, qdd)) < 1e-15);
+  CHECK((p5.constraint->A(q) - robot.constraint.A(q)).norm() < 1e-15);
+  try {
+    nhdyn::io::parse_model(R"({"name": "x", "gravity": [0, 0, -9.81], "links": [{"joint": "revolute",
+      "alpha": 0, "a": 0.7, "theta": 0, "d": 0, "mass": 2, "com": [0, 0],
+      "inertia": [[0, 0, 0], [0, 0, 0], [0, 0, 0]]}]})", "inline");
+    FAIL("no model_error thrown");
+  } catch (const nhdyn::model_error& e) {
+    CHECK_THAT(e.what(), Catch::Contains("link 1, field 'com'"));
   }
 }
