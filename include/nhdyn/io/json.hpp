@@ -57,6 +57,7 @@ struct model {
 /// Throws numerical_error for NaN or Inf, which JSON cannot represent.
 inline std::string format_number(double x) {
   if (!std::isfinite(x)) throw numerical_error(std::isnan(x) ? "result is NaN" : "result is infinite");
+  if (x == 0 && std::signbit(x)) return "-0.0";  // "-0" would read back as the integer 0
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.17g", x);
   return buf;
@@ -376,11 +377,15 @@ model<S> preset(std::string_view name) {
     const auto& c = r.constraint;
     return {r.chain.dynamic_size(),
             differential_drive<S>(c.n, c.x, c.y, c.heading, c.forward_offset, c.heading_sign),
-            "The 5-DOF mobile manipulator of ../shared/spec/paper5.md (Salazar-Silva et al., Tables I-II)"};
+            "The 5-DOF nonholonomic mobile manipulator of Salazar-Silva et al. (Tables I-II): a "
+            "differential-drive platform (q1, q2 base position, q3 heading) carrying a planar 2-link "
+            "arm (q4, q5); box inertias from the box formulas; eta = (v, omega, qd4, qd5)"};
   }
   if (name == "puma560")
     return {presets::puma560<S>().dynamic_size(), std::nullopt,
-            "Unimation Puma 560, standard DH, rigid-body parameters of Corke's Robotics Toolbox mdl_puma560.m"};
+            "Unimation Puma 560, standard DH, rigid-body parameters of P. Corke's Robotics Toolbox "
+            "mdl_puma560.m (Armstrong, Khatib & Burdick 1986); no motor inertia, gearing or friction; "
+            "links 1 and 3 violate the triangle inequality as published"};
   std::string known;
   for (const auto& n : preset_names()) known += (known.empty() ? "" : ", ") + n;
   throw model_error("unknown preset '" + std::string(name) + "' (known: " + known + ")");
