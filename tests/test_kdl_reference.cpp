@@ -132,6 +132,17 @@ TEST_CASE("kdl: rne equals KDL's ChainIdSolver_RNE on random mixed chains with m
     }
 }
 
+TEST_CASE("kdl: rne equals KDL's ChainIdSolver_RNE on long revolute chains (the benchmark sizes)") {
+  std::mt19937_64 rng(34);
+  worst w_id("rne vs KDL ChainIdSolver_RNE, 6…96 revolute links"), w_M("M vs KDL ChainDynParam, 6…96 links"),
+      w_cg("C qd, g vs KDL ChainDynParam, 6…96 links");
+  for (const int n : {6, 12, 24, 48, 96}) {
+    const auto c = nhdyn_ref::random_chain(rng, n, {.prismatic_probability = 0.0});
+    compare(c, rng, 2, w_id, w_M, w_cg);
+    if (n == 12) compare(c.fixed<12>(), rng, 2, w_id, w_M, w_cg);
+  }
+}
+
 TEST_CASE("kdl: rne equals KDL's ChainIdSolver_RNE on puma560 and paper5, fixed and run-time sized") {
   std::mt19937_64 rng(32);
   worst w_id("rne vs KDL ChainIdSolver_RNE, puma560 + paper5"), w_M("M vs KDL ChainDynParam, presets"),
