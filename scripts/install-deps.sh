@@ -6,7 +6,7 @@ pkgs=(
   build-essential cmake g++ clang-14 libclang-rt-14-dev
   libeigen3-dev librange-v3-dev catch2 libbenchmark-dev
   libboost-dev liborocos-kdl-dev nlohmann-json3-dev libsundials-dev
-  gnuplot-nox
+  gnuplot-nox python3-matplotlib
 )
 missing=()
 for p in "${pkgs[@]}"; do

@@ -1,0 +1,57 @@
+/// \file bench/kdl_reference.cpp
+/// KDL side of the benchmark (see kdl_reference.hpp). Built with baseline flags only.
+#include "kdl_reference.hpp"
+
+#include <kdl/chain.hpp>
+#include <kdl/chainidsolver_recursive_newton_euler.hpp>
+#include <kdl/frames.hpp>
+#include <kdl/jntarray.hpp>
+#include <kdl/rigidbodyinertia.hpp>
+#include <kdl/rotationalinertia.hpp>
+#include <kdl/segment.hpp>
+#include <memory>
+
+namespace nhdyn_bench::kdl {
+
+struct solver {
+  KDL::Chain chain;
+  std::unique_ptr<KDL::ChainIdSolver_RNE> id;
+  KDL::JntArray q, qd, qdd, tau;
+  KDL::Wrenches f_ext;
+};
+
+solver* make(const dh_row* rows, int n, const double g[3]) {
+  auto* s = new solver;
+  for (int i = 0; i < n; ++i) {
+    const dh_row& r = rows[i];
+    const double* I = r.inertia;
+    // RotationalInertia(Ixx, Iyy, Izz, Ixy, Ixz, Iyz), about the centre of mass here
+    // (RigidBodyInertia's third argument is "the rotational inertia in the cog").
+    const KDL::RotationalInertia Ic(I[0], I[4], I[8], I[1], I[2], I[5]);
+    const KDL::RigidBodyInertia rbi(r.mass, KDL::Vector(r.com[0], r.com[1], r.com[2]), Ic);
+    const KDL::Joint j(r.prismatic ? KDL::Joint::TransZ : KDL::Joint::RotZ);
+    s->chain.addSegment(KDL::Segment(j, KDL::Frame::DH(r.a, r.alpha, r.d, r.theta), rbi));
+  }
+  s->id = std::make_unique<KDL::ChainIdSolver_RNE>(s->chain, KDL::Vector(g[0], g[1], g[2]));
+  s->q = s->qd = s->qdd = s->tau = KDL::JntArray(static_cast<unsigned>(n));
+  s->f_ext.assign(static_cast<std::size_t>(n), KDL::Wrench::Zero());
+  return s;
+}
+
+void destroy(solver* s) { delete s; }
+
+void set_state(solver* s, const double* q, const double* qd, const double* qdd) {
+  for (unsigned i = 0; i < s->q.rows(); ++i) {
+    s->q(i) = q[i];
+    s->qd(i) = qd[i];
+    s->qdd(i) = qdd[i];
+  }
+}
+
+int run(solver* s) { return s->id->CartToJnt(s->q, s->qd, s->qdd, s->f_ext, s->tau); }
+
+void torques(const solver* s, double* tau) {
+  for (unsigned i = 0; i < s->tau.rows(); ++i) tau[i] = s->tau(i);
+}
+
+}  // namespace nhdyn_bench::kdl

@@ -1,0 +1,254 @@
+/// \file bench/nhdyn_bench.cpp
+/// nhdyn's benchmarks (Google Benchmark). Names pair up for scripts/perf_table.py:
+///   rne/<model>/{nhdyn, nhdyn_fixed, kdl}       holonomic inverse dynamics vs Orocos KDL
+///   nh_id/<model>/{rne, rne_fixed, lagrange}    nonholonomic inverse dynamics vs projected E–L
+///   scene/<model>/<variant>                     "model only what a scene requires"
+///   nh_inertia/<model>/{crba, rne_columns}      M_η = SᵀMS two ways
+/// Every case checks its answer once, untimed, against an independent computation (KDL, the
+/// Lagrangian, the run-time-sized variant) and aborts on disagreement; every case reports
+/// `allocs_per_call`, the heap allocations of one call (counted by alloc_counter.cpp).
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+
+#include "alloc_counter.hpp"
+#include "lagrange.hpp"
+#include "models.hpp"
+
+namespace nhdyn_bench {
+namespace {
+
+[[noreturn]] void fail(const std::string& what) {
+  std::fprintf(stderr, "nhdyn_bench: %s\n", what.c_str());
+  std::exit(2);
+}
+
+/// |a − b|∞ ≤ tol·max(1, |b|∞), or abort naming the case.
+template <class A, class B>
+void agree(const A& a, const B& b, double tol, const std::string& what) {
+  const Eigen::VectorXd x = a, y = b;
+  if (x.size() != y.size()) fail(what + ": sizes differ");
+  const double err = (x - y).lpNorm<Eigen::Infinity>();
+  const double scale = std::max(1.0, y.lpNorm<Eigen::Infinity>());
+  if (!(err <= tol * scale)) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, ": disagreement %.3e > %.1e (scale %.3e)", err, tol, scale);
+    fail(what + buf);
+  }
+}
+
+/// Heap allocations per call of f, averaged over 64 calls (untimed).
+template <class F>
+double allocs_per_call(F&& f) {
+  f();  // warm-up
+  const auto before = allocations();
+  for (int i = 0; i < 64; ++i) f();
+  return double(allocations() - before) / 64.0;
+}
+
+/// Registers name → a loop over f(); f is also called by allocs_per_call.
+template <class F>
+void add(const std::string& name, F f) {
+  auto fp = std::make_shared<F>(std::move(f));
+  benchmark::RegisterBenchmark(name.c_str(), [fp](benchmark::State& st) {
+    st.counters["allocs_per_call"] = allocs_per_call(*fp);
+    for (auto _ : st) (*fp)();
+  });
+}
+
+template <class V>
+void opaque(V& v) {
+  benchmark::DoNotOptimize(v);
+}
+
+// ---------------------------------------------------------------- issue 2: rne vs KDL
+
+template <int N>
+void register_rne(const std::string& model, const chain<double>& cd, bool with_kdl = true) {
+  const int n = cd.dof();
+  const state s = random_state(n);
+  const auto cf = cd.fixed<N>();
+  auto idd = nhdyn::rne(cd);
+  auto idf = nhdyn::rne(cf);
+  const Eigen::VectorXd tau_d = idd(s.q, s.qd, s.qdd);
+  const nhdyn::vecN<double, N> qf = s.q, qdf = s.qd, qddf = s.qdd;
+  agree(idf(qf, qdf, qddf), tau_d, 1e-14, "rne/" + model + ": fixed vs run-time sized");
+  add("rne/" + model + "/nhdyn", [idd, s]() mutable {
+    opaque(s.q), opaque(s.qd), opaque(s.qdd);
+    auto tau = idd(s.q, s.qd, s.qdd);
+    benchmark::DoNotOptimize(tau);
+  });
+  add("rne/" + model + "/nhdyn_fixed", [idf, qf, qdf, qddf]() mutable {
+    opaque(qf), opaque(qdf), opaque(qddf);
+    auto tau = idf(qf, qdf, qddf);
+    benchmark::DoNotOptimize(tau);
+  });
+  if (!with_kdl) return;
+  const auto rows = kdl_rows(cd);
+  std::shared_ptr<kdl::solver> k(kdl::make(rows.data(), n, cd.gravity().data()), kdl::destroy);
+  kdl::set_state(k.get(), s.q.data(), s.qd.data(), s.qdd.data());
+  if (kdl::run(k.get()) != 0) fail("rne/" + model + ": KDL's solver returned an error");
+  Eigen::VectorXd tau_k(n);
+  kdl::torques(k.get(), tau_k.data());
+  agree(tau_d, tau_k, 1e-10, "rne/" + model + ": nhdyn vs KDL ChainIdSolver_RNE");
+  add("rne/" + model + "/kdl", [k]() { benchmark::DoNotOptimize(kdl::run(k.get())); });
+}
+
+// ------------------------------------------------- issue 3: nonholonomic id vs Lagrange
+
+struct nh_state {
+  Eigen::VectorXd q, eta, eta_dot;
+};
+inline nh_state random_nh_state(int n) {
+  const state s = random_state(n, 11);
+  return {s.q, s.qd.head(n - 1), s.qdd.head(n - 1)};
+}
+
+template <int N>
+void register_nh(const std::string& model, const chain<double>& cd) {
+  const int n = cd.dof();
+  const nh_state z = random_nh_state(n);
+  const auto cf = cd.fixed<N>();
+  const auto cond = ddrive_constraint<dynamic>(n);
+  const auto conf = ddrive_constraint<N>(n);
+  auto idd = nhdyn::inverse_dynamics(cd, cond);
+  auto idf = nhdyn::inverse_dynamics(cf, conf);
+  projected_lagrange<nhdyn::differential_drive<double, dynamic>> el(cd, cond);
+  const Eigen::VectorXd tau_d = idd(z.q, z.eta, z.eta_dot);
+  agree(tau_d, el(z.q, z.eta, z.eta_dot), 1e-10, "nh_id/" + model + ": rne vs projected Lagrange");
+  constexpr int M = N - 1;
+  const nhdyn::vecN<double, N> qf = z.q;
+  const nhdyn::vecN<double, M> ef = z.eta, edf = z.eta_dot;
+  agree(idf(qf, ef, edf), tau_d, 1e-14, "nh_id/" + model + ": fixed vs run-time sized");
+  add("nh_id/" + model + "/rne", [idd, z]() mutable {
+    opaque(z.q), opaque(z.eta), opaque(z.eta_dot);
+    auto tau = idd(z.q, z.eta, z.eta_dot);
+    benchmark::DoNotOptimize(tau);
+  });
+  add("nh_id/" + model + "/rne_fixed", [idf, qf, ef, edf]() mutable {
+    opaque(qf), opaque(ef), opaque(edf);
+    auto tau = idf(qf, ef, edf);
+    benchmark::DoNotOptimize(tau);
+  });
+  add("nh_id/" + model + "/lagrange", [el, z]() mutable {
+    opaque(z.q), opaque(z.eta), opaque(z.eta_dot);
+    auto tau = el(z.q, z.eta, z.eta_dot);
+    benchmark::DoNotOptimize(tau);
+  });
+  // M_η two ways (nh_forward_dynamics' reduced_inertia_method).
+  auto fc = nhdyn::nh_forward_dynamics(cf, conf, {}, nhdyn::reduced_inertia_method::crba);
+  auto fr = nhdyn::nh_forward_dynamics(cf, conf, {}, nhdyn::reduced_inertia_method::rne_columns);
+  const Eigen::MatrixXd Mc = fc.reduced_inertia(qf), Mr = fr.reduced_inertia(qf);
+  agree(Eigen::Map<const Eigen::VectorXd>(Mc.data(), Mc.size()),
+        Eigen::Map<const Eigen::VectorXd>(Mr.data(), Mr.size()), 1e-12,
+        "nh_inertia/" + model + ": crba vs rne_columns");
+  add("nh_inertia/" + model + "/crba", [fc, qf]() mutable {
+    opaque(qf);
+    auto Me = fc.reduced_inertia(qf);
+    benchmark::DoNotOptimize(Me);
+  });
+  add("nh_inertia/" + model + "/rne_columns", [fr, qf]() mutable {
+    opaque(qf);
+    auto Me = fr.reduced_inertia(qf);
+    benchmark::DoNotOptimize(Me);
+  });
+}
+
+// ------------------------------------------- "model only what a scene requires" (issue 3)
+
+/// The chain with its massless links (zero mass, zero inertia) given 1 kg and a 0.1 m cube.
+chain<double> without_massless_links(const chain<double>& c) {
+  std::vector<link<double>> L(c.begin(), c.end());
+  for (auto& l : L)
+    if (l.mass == 0.0 && l.inertia.isZero(0.0)) {
+      l.mass = 1.0;
+      l.inertia = nhdyn::box_inertia<double>(1.0, 0.1, 0.1, 0.1);
+    }
+  return chain<double>(L, c.gravity(), c.name() + "_massive");
+}
+/// The chain with every other arm link (index ≥ 3, odd) massless.
+chain<double> half_arm_massless(const chain<double>& c) {
+  std::vector<link<double>> L(c.begin(), c.end());
+  for (std::size_t i = 3; i < L.size(); i += 2) {
+    L[i].mass = 0.0;
+    L[i].com.setZero();
+    L[i].inertia.setZero();
+  }
+  return chain<double>(L, c.gravity(), c.name() + "_half_massless");
+}
+
+template <int N>
+void register_scene(const std::string& model, const chain<double>& cd) {
+  const int n = cd.dof();
+  const nh_state z = random_nh_state(n);
+  const auto cf = cd.fixed<N>();
+  const auto con = ddrive_constraint<N>(n);
+  constexpr int M = N - 1;
+  const nhdyn::vecN<double, N> q = z.q;
+  const nhdyn::vecN<double, M> e = z.eta, ed = z.eta_dot;
+  const auto id_case = [&](const std::string& variant, auto id) {
+    add("scene/" + model + "/" + variant, [id, q, e, ed]() mutable {
+      opaque(q), opaque(e), opaque(ed);
+      auto tau = id(q, e, ed);
+      benchmark::DoNotOptimize(tau);
+    });
+  };
+  id_case("full", nhdyn::inverse_dynamics(cf, con));
+  id_case("no_gravity", nhdyn::inverse_dynamics(cf, con, {false, true}));
+  id_case("no_velocity", nhdyn::inverse_dynamics(cf, con, {true, false}));
+  id_case("no_gravity_no_velocity", nhdyn::inverse_dynamics(cf, con, {false, false}));
+  id_case("with_constraint_forces", nhdyn::inverse_dynamics_with_forces(cf, con));
+  {
+    auto id = nhdyn::inverse_dynamics(cd, ddrive_constraint<dynamic>(n));
+    add("scene/" + model + "/run_time_sized", [id, z]() mutable {
+      opaque(z.q), opaque(z.eta), opaque(z.eta_dot);
+      auto tau = id(z.q, z.eta, z.eta_dot);
+      benchmark::DoNotOptimize(tau);
+    });
+  }
+  id_case("no_massless_links", nhdyn::inverse_dynamics(without_massless_links(cd).fixed<N>(), con));
+  if (n > 8) id_case("half_arm_massless", nhdyn::inverse_dynamics(half_arm_massless(cd).fixed<N>(), con));
+}
+
+}  // namespace
+}  // namespace nhdyn_bench
+
+int main(int argc, char** argv) {
+  using namespace nhdyn_bench;
+  const auto p5 = nhdyn::presets::paper5_chain<double>().dynamic_size();
+  register_rne<5>("paper5", p5);
+  register_rne<6>("puma560", nhdyn::presets::puma560<double>().dynamic_size());
+  register_rne<6>("rev6", random_chain(6));
+  register_rne<12>("rev12", random_chain(12));
+  register_rne<24>("rev24", random_chain(24));
+  register_rne<48>("rev48", random_chain(48));
+  register_rne<96>("rev96", random_chain(96));
+
+  register_nh<5>("paper5", p5);
+  register_rne<5>("ddrive_arm2", ddrive_arm(2), false);
+  register_nh<5>("ddrive_arm2", ddrive_arm(2));
+  register_rne<7>("ddrive_arm4", ddrive_arm(4), false);
+  register_nh<7>("ddrive_arm4", ddrive_arm(4));
+  register_rne<11>("ddrive_arm8", ddrive_arm(8), false);
+  register_nh<11>("ddrive_arm8", ddrive_arm(8));
+  register_rne<19>("ddrive_arm16", ddrive_arm(16), false);
+  register_nh<19>("ddrive_arm16", ddrive_arm(16));
+  register_rne<27>("ddrive_arm24", ddrive_arm(24), false);
+  register_nh<27>("ddrive_arm24", ddrive_arm(24));
+  register_rne<51>("ddrive_arm48", ddrive_arm(48), false);
+  register_nh<51>("ddrive_arm48", ddrive_arm(48));
+
+  register_scene<5>("paper5", p5);
+  register_scene<27>("ddrive_arm24", ddrive_arm(24));
+
+  benchmark::AddCustomContext("nhdyn_compiler", NHDYN_BENCH_CXX);
+  benchmark::AddCustomContext("nhdyn_flags", NHDYN_BENCH_FLAGS);
+  benchmark::AddCustomContext("kdl_flags", "-O3 (baseline x86-64, no -march)");
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

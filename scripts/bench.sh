@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Builds and runs nhdyn's benchmarks, writes docs/performance.json, and regenerates the tables
+# of docs/performance.md and the plot docs/performance_scaling.png from it.
+#
+#   scripts/bench.sh                       # 5 repetitions, medians
+#   NHDYN_BENCH_REPS=9 scripts/bench.sh    # more repetitions
+#   NHDYN_BENCH_FILTER='^rne/' scripts/bench.sh --no-docs   # a subset, JSON only
+#
+# Environment: NHDYN_BENCH_BUILD (build dir, default build-bench), NHDYN_BENCH_REPS (5),
+# NHDYN_BENCH_MIN_TIME (seconds per repetition, 0.1), NHDYN_BENCH_FILTER (regex, all),
+# CXX (compiler, default g++).
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+build="${NHDYN_BENCH_BUILD:-$root/build-bench}"
+reps="${NHDYN_BENCH_REPS:-5}"
+min_time="${NHDYN_BENCH_MIN_TIME:-0.1}"
+filter="${NHDYN_BENCH_FILTER:-.}"
+docs=1
+[ "${1:-}" = "--no-docs" ] && docs=0
+
+"$root/scripts/install-deps.sh"
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER="${CXX:-g++}" \
+  -DNHDYN_BUILD_BENCH=ON -DNHDYN_BUILD_TESTS=OFF -DNHDYN_BUILD_EXAMPLES=OFF >/dev/null
+make -C "$build" -j2 nhdyn_bench
+
+json="$root/docs/performance.json"
+[ $docs -eq 0 ] && json="$build/performance.json"
+"$build/bench/nhdyn_bench" --benchmark_repetitions="$reps" --benchmark_report_aggregates_only=true \
+  --benchmark_min_time="$min_time" --benchmark_filter="$filter" \
+  --benchmark_out="$json" --benchmark_out_format=json
+echo "bench.sh: wrote $json"
+[ $docs -eq 0 ] && exit 0
+
+# Debian's python3 carries matplotlib (python3-matplotlib); prefer it over other pythons on PATH.
+py=/usr/bin/python3
+[ -x "$py" ] || py=python3
+cpu="$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -1)"
+compiler="$("${CXX:-g++}" --version | head -1)"
+"$py" "$root/scripts/perf_table.py" "$json" "$root/docs/performance.md" "$root/docs/performance_scaling.png" \
+  --cpu "$cpu" --compiler "$compiler"

@@ -1,0 +1,260 @@
+#!/usr/bin/env python3
+"""Turns nhdyn_bench's JSON (Google Benchmark, --benchmark_repetitions=N with aggregates)
+into the tables of docs/performance.md and the plot docs/performance_scaling.png.
+
+Usage: perf_table.py BENCH.json DOC.md PLOT.png [--cpu "model name"] [--compiler "g++ ..."]
+
+The generated part of DOC.md lies between the markers
+    <!-- BEGIN GENERATED: scripts/bench.sh -->  and  <!-- END GENERATED -->
+and is replaced; the rest of the file is kept. Every number is a median over the
+repetitions of CPU time per call (ns), taken from the JSON, never typed in by hand.
+"""
+import argparse
+import json
+import math
+import re
+import sys
+
+BEGIN = "<!-- BEGIN GENERATED: scripts/bench.sh -->"
+END = "<!-- END GENERATED -->"
+
+RNE_MODELS = ["paper5", "puma560", "rev6", "rev12", "rev24", "rev48", "rev96"]
+NH_MODELS = ["paper5", "ddrive_arm2", "ddrive_arm4", "ddrive_arm8", "ddrive_arm16",
+             "ddrive_arm24", "ddrive_arm48"]
+DOF = {"paper5": 5, "puma560": 6, "rev6": 6, "rev12": 12, "rev24": 24, "rev48": 48,
+       "rev96": 96}
+for a in (2, 4, 8, 16, 24, 48):
+    DOF[f"ddrive_arm{a}"] = 3 + a
+SCENE_VARIANTS = [
+    ("full", "everything (gravity, velocity terms, τ only), compile-time sized"),
+    ("no_gravity", "gravity off"),
+    ("no_velocity", "velocity terms off (C(q, q̇)q̇ dropped)"),
+    ("no_gravity_no_velocity", "gravity and velocity terms off (M_η η̇ only)"),
+    ("with_constraint_forces", "τ and the constraint forces λ (inverse_dynamics_with_forces)"),
+    ("run_time_sized", "run-time-sized chain and constraint"),
+    ("no_massless_links", "base links 1–2 given 1 kg (no massless link to skip)"),
+    ("half_arm_massless", "every other arm link massless (skipped)"),
+]
+TARGET_FIXED, TARGET_DYN, TARGET_NH = 0.25, 0.35, 1.3
+
+
+def load(path):
+    with open(path) as f:
+        data = json.load(f)
+    med, allocs, reps = {}, {}, {}
+    for b in data["benchmarks"]:
+        name = b.get("run_name", b["name"])
+        if b.get("aggregate_name") == "median":
+            med[name] = b["cpu_time"] * {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[b["time_unit"]]
+            if "allocs_per_call" in b:
+                allocs[name] = b["allocs_per_call"]
+            reps[name] = b.get("repetitions", 1)
+    if not med:
+        sys.exit("perf_table.py: no median aggregates in %s (run with --benchmark_repetitions)" % path)
+    return data["context"], med, allocs, reps
+
+
+def ns(x):
+    if x is None:
+        return "—"
+    if x >= 1e6:
+        return f"{x / 1e6:.2f} ms"
+    if x >= 1e4:
+        return f"{x / 1e3:.1f} µs"
+    return f"{x:.0f}"
+
+
+def ratio(a, b):
+    return None if a is None or b is None else a / b
+
+
+def r2(x):
+    return "—" if x is None else f"{x:.2f}"
+
+
+def al(x):
+    return "—" if x is None else (f"{x:.0f}" if abs(x - round(x)) < 1e-9 else f"{x:.2f}")
+
+
+def slope(ns_, ts):
+    """Least-squares exponent p of t ≈ c·nᵖ."""
+    pts = [(math.log(n), math.log(t)) for n, t in zip(ns_, ts) if t]
+    if len(pts) < 2:
+        return None
+    mx = sum(p[0] for p in pts) / len(pts)
+    my = sum(p[1] for p in pts) / len(pts)
+    sxx = sum((p[0] - mx) ** 2 for p in pts)
+    return sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx
+
+
+def tables(ctx, med, allocs, reps, cpu, compiler):
+    g = med.get
+    out = []
+    nrep = max(reps.values())
+    out.append(f"Measured {ctx.get('date', '?')} on **{cpu}** ({ctx.get('num_cpus', '?')} logical CPUs, "
+               f"shared with other jobs), nhdyn compiled by **{compiler}** with "
+               f"`{ctx.get('nhdyn_flags', '?')}`; KDL {ctx.get('kdl_flags', '?')}. Every figure is the "
+               f"**median of {nrep} repetitions** of the CPU time per call in nanoseconds "
+               f"(Google Benchmark `cpu_time`), from `docs/performance.json`.\n")
+
+    # ---------------------------------------------------------------- rne vs KDL
+    out.append("### Holonomic rne against Orocos KDL (issue 2)\n")
+    out.append("| model | n | nhdyn run-time sized | nhdyn fixed | KDL | run-time / KDL | fixed / KDL "
+               "| allocations per call (run-time, fixed, KDL) |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|---|")
+    worst_fixed = worst_dyn = 0.0
+    for m in RNE_MODELS:
+        d, f, k = g(f"rne/{m}/nhdyn"), g(f"rne/{m}/nhdyn_fixed"), g(f"rne/{m}/kdl")
+        rd, rf = ratio(d, k), ratio(f, k)
+        worst_fixed = max(worst_fixed, rf or 0)
+        worst_dyn = max(worst_dyn, rd or 0)
+        out.append(f"| {m} | {DOF[m]} | {ns(d)} | {ns(f)} | {ns(k)} | {r2(rd)} | {r2(rf)} | "
+                   f"{al(allocs.get(f'rne/{m}/nhdyn'))}, {al(allocs.get(f'rne/{m}/nhdyn_fixed'))}, "
+                   f"{al(allocs.get(f'rne/{m}/kdl'))} |")
+    fixed_allocs = max(allocs.get(f"rne/{m}/nhdyn_fixed", 0) for m in RNE_MODELS)
+    out.append("")
+    out.append(f"- Target fixed-size ≤ {TARGET_FIXED}× KDL on every model: worst ratio "
+               f"**{worst_fixed:.2f}** — {'met' if worst_fixed <= TARGET_FIXED else 'NOT met'}.")
+    out.append(f"- Target run-time-sized ≤ {TARGET_DYN}× KDL: worst ratio **{worst_dyn:.2f}** — "
+               f"{'met' if worst_dyn <= TARGET_DYN else 'NOT met'}.")
+    out.append(f"- Heap allocations per call, fixed-size models: **{al(fixed_allocs)}** (counted, see "
+               f"below) — {'met' if fixed_allocs == 0 else 'NOT met'}. The run-time-sized call makes "
+               f"exactly one: the returned `Eigen::VectorXd`.")
+    ks = [DOF[m] for m in RNE_MODELS if m.startswith("rev")]
+    for label, suf in (("nhdyn fixed", "nhdyn_fixed"), ("nhdyn run-time", "nhdyn"), ("KDL", "kdl")):
+        ts = [g(f"rne/rev{n}/{suf}") for n in ks]
+        out.append(f"- Growth on the revolute chains 6…96, {label}: time ∝ n^{slope(ks, ts):.2f} "
+                   f"(least-squares over all sizes), n^{slope(ks[-2:], ts[-2:]):.2f} between the two largest.")
+    out.append("")
+
+    # ---------------------------------------------------------------- nh vs holonomic, Lagrange
+    out.append("### Nonholonomic inverse dynamics: rne against the holonomic rne and projected Euler–Lagrange (issue 3)\n")
+    out.append("Holonomic = `rne/<model>/nhdyn*` on the same chain without the constraint; "
+               "nh = `nh_id/<model>/rne*` = project ∘ rne ∘ lift; E–L = `nh_id/<model>/lagrange`.\n")
+    out.append("| model | n | holonomic fixed | nh fixed | nh / holonomic (fixed) | holonomic run-time | "
+               "nh run-time | nh / holonomic (run-time) | E–L | E–L / nh run-time | allocations nh (run-time, fixed) |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+    worst_nh_f = worst_nh_d = 0.0
+    for m in NH_MODELS:
+        hf, nf = g(f"rne/{m}/nhdyn_fixed"), g(f"nh_id/{m}/rne_fixed")
+        hd, nd = g(f"rne/{m}/nhdyn"), g(f"nh_id/{m}/rne")
+        el = g(f"nh_id/{m}/lagrange")
+        worst_nh_f = max(worst_nh_f, ratio(nf, hf) or 0)
+        worst_nh_d = max(worst_nh_d, ratio(nd, hd) or 0)
+        out.append(f"| {m} | {DOF[m]} | {ns(hf)} | {ns(nf)} | {r2(ratio(nf, hf))} | {ns(hd)} | {ns(nd)} | "
+                   f"{r2(ratio(nd, hd))} | {ns(el)} | {ratio(el, nd):.0f} | "
+                   f"{al(allocs.get(f'nh_id/{m}/rne'))}, {al(allocs.get(f'nh_id/{m}/rne_fixed'))} |")
+    out.append("")
+    out.append(f"- Target nh ≤ {TARGET_NH}× holonomic rne of the same chain: compile-time sized, worst "
+               f"**{worst_nh_f:.2f}** — {'met' if worst_nh_f <= TARGET_NH else 'NOT met'}; run-time sized, "
+               f"worst **{worst_nh_d:.2f}** — {'met' if worst_nh_d <= TARGET_NH else 'NOT met'}.")
+    arms = [DOF[m] for m in NH_MODELS if m.startswith("ddrive")]
+    for label, key in (("holonomic rne (fixed)", "rne/{}/nhdyn_fixed"), ("nh rne (fixed)", "nh_id/{}/rne_fixed"),
+                       ("nh rne (run-time)", "nh_id/{}/rne"), ("projected E–L", "nh_id/{}/lagrange")):
+        ts = [g(key.format(f"ddrive_arm{a - 3}")) for a in arms]
+        out.append(f"- Growth on the differential-drive arms (n = 5…51), {label}: time ∝ n^{slope(arms, ts):.2f} "
+                   f"(least-squares over all sizes), n^{slope(arms[-2:], ts[-2:]):.2f} between the two largest.")
+    out.append("")
+
+    # ---------------------------------------------------------------- scenes
+    out.append("### Model only what a scene requires (issue 3)\n")
+    out.append("Nonholonomic inverse dynamics (`inverse_dynamics`, compile-time sized unless said), "
+               "relative to `full` of the same model.\n")
+    out.append("| variant | what it computes | paper5 | × full | ddrive_arm24 (n = 27) | × full |")
+    out.append("|---|---|---:|---:|---:|---:|")
+    for v, what in SCENE_VARIANTS:
+        a, b = g(f"scene/paper5/{v}"), g(f"scene/ddrive_arm24/{v}")
+        fa, fb = g("scene/paper5/full"), g("scene/ddrive_arm24/full")
+        out.append(f"| `{v}` | {what} | {ns(a)} | {r2(ratio(a, fa))} | {ns(b)} | {r2(ratio(b, fb))} |")
+    out.append("")
+
+    # ---------------------------------------------------------------- M_eta
+    out.append("### M_η = SᵀMS: composite rigid body vs m rne columns (nh_forward_dynamics)\n")
+    out.append("| model | n | crba | rne_columns | rne_columns / crba | faster |")
+    out.append("|---|---:|---:|---:|---:|---|")
+    crba_wins = 0
+    for m in NH_MODELS:
+        c, r = g(f"nh_inertia/{m}/crba"), g(f"nh_inertia/{m}/rne_columns")
+        crba_wins += (c or 0) < (r or 0)
+        out.append(f"| {m} | {DOF[m]} | {ns(c)} | {ns(r)} | {r2(ratio(r, c))} | "
+                   f"{'crba' if c < r else 'rne_columns'} |")
+    out.append("")
+    out.append(f"- crba is faster on {crba_wins} of {len(NH_MODELS)} models; "
+               f"`reduced_inertia_method::crba` is the default.")
+    out.append("")
+    out.append("![scaling](performance_scaling.png)")
+    return "\n".join(out) + "\n"
+
+
+def plot(med, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    g = med.get
+    fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(16, 4.4))
+    ks = [6, 12, 24, 48, 96]
+    for suf, lab, st in (("kdl", "KDL ChainIdSolver_RNE", "s-"), ("nhdyn", "nhdyn run-time sized", "o-"),
+                         ("nhdyn_fixed", "nhdyn fixed size", "^-")):
+        a1.loglog(ks, [g(f"rne/rev{n}/{suf}") for n in ks], st, label=lab)
+    a1.set_xlabel("joints n (random revolute chains)")
+    a1.set_ylabel("ns per call (median CPU time)")
+    a1.set_title("holonomic inverse dynamics")
+    a1.legend()
+    a1.grid(True, which="both", alpha=0.3)
+    arms = [2, 4, 8, 16, 24, 48]
+    n = [3 + a for a in arms]
+    for key, lab, st in (("nh_id/ddrive_arm{}/lagrange", "projected Euler–Lagrange", "s-"),
+                         ("nh_id/ddrive_arm{}/rne", "nh rne (project∘rne∘lift), run-time", "o-"),
+                         ("nh_id/ddrive_arm{}/rne_fixed", "nh rne, fixed size", "^-"),
+                         ("rne/ddrive_arm{}/nhdyn_fixed", "holonomic rne, fixed size", "v--")):
+        a2.loglog(n, [g(key.format(a)) for a in arms], st, label=lab)
+    a2.set_xlabel("joints n (differential-drive base + arm)")
+    a2.set_title("nonholonomic inverse dynamics")
+    a2.legend(fontsize=8)
+    a2.grid(True, which="both", alpha=0.3)
+    a3.loglog(ks, [g(f"rne/rev{n}/nhdyn_fixed") / g(f"rne/rev{n}/kdl") for n in ks], "^-",
+               label="nhdyn fixed / KDL (rev chains)")
+    a3.loglog(ks, [g(f"rne/rev{n}/nhdyn") / g(f"rne/rev{n}/kdl") for n in ks], "o-",
+               label="nhdyn run-time / KDL (rev chains)")
+    a3.loglog(n, [g(f"nh_id/ddrive_arm{a}/rne_fixed") / g(f"rne/ddrive_arm{a}/nhdyn_fixed") for a in arms],
+               "v-", label="nh / holonomic rne, fixed (ddrive)")
+    a3.loglog(n, [g(f"nh_id/ddrive_arm{a}/rne") / g(f"rne/ddrive_arm{a}/nhdyn") for a in arms],
+               "d-", label="nh / holonomic rne, run-time (ddrive)")
+    a3.loglog(n, [g(f"nh_id/ddrive_arm{a}/lagrange") / g(f"nh_id/ddrive_arm{a}/rne") for a in arms],
+               "s-", label="projected E–L / nh rne, run-time (ddrive)")
+    for y, lab in ((TARGET_FIXED, "target 0.25"), (TARGET_DYN, "target 0.35"), (TARGET_NH, "target 1.3")):
+        a3.axhline(y, color="grey", lw=0.8, ls=":")
+        a3.text(ks[-1], y, lab, fontsize=7, va="bottom", ha="right", color="grey")
+    a3.set_xlabel("joints n")
+    a3.set_ylabel("time ratio")
+    a3.set_title("ratios")
+    a3.legend(fontsize=7)
+    a3.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("json")
+    ap.add_argument("doc")
+    ap.add_argument("png")
+    ap.add_argument("--cpu", default="unknown CPU")
+    ap.add_argument("--compiler", default="unknown compiler")
+    a = ap.parse_args()
+    ctx, med, allocs, reps = load(a.json)
+    text = tables(ctx, med, allocs, reps, a.cpu, a.compiler)
+    with open(a.doc) as f:
+        doc = f.read()
+    if BEGIN not in doc or END not in doc:
+        sys.exit(f"perf_table.py: {a.doc} lacks the markers {BEGIN} … {END}")
+    doc = re.sub(re.escape(BEGIN) + ".*?" + re.escape(END), lambda _: BEGIN + "\n" + text + END, doc,
+                 flags=re.S)
+    with open(a.doc, "w") as f:
+        f.write(doc)
+    plot(med, a.png)
+    print(f"perf_table.py: wrote {a.doc} and {a.png}")
+
+
+if __name__ == "__main__":
+    main()
