@@ -8,7 +8,8 @@
 /// plus one line here.
 #define NHDYN_TOOL_COMMANDS(X) \
   X(id)                        \
-  X(fd)
+  X(fd)                        \
+  X(simulate)
 
 #include <iostream>
 

@@ -1,0 +1,171 @@
+#pragma once
+/// \file simulation/controller.hpp
+/// The paper's robust task-space controller (paper.md §3, Salazar-Silva et al. §V) for a
+/// point r ∈ R³ on the last link, as paper5.md uses it:
+///
+///     r̃ = r_d − r,  dr̃/dt = ṙ_d − B η,  e = (r̃, dr̃/dt) ∈ R⁶,  H = [0; −I₃]
+///     δ   = −ρ(e) Hᵀ P e / max(‖Hᵀ P e‖, ε)   (0 where Hᵀ P e = 0)             (eq. 26–28)
+///     ρ(e) = (γ₂‖e‖² + γ₁‖e‖ + γ₀) / (1 − α)
+///     a_r = r̈_d + K₁ dr̃/dt + K₀ r̃ + δ                                          (eq. 23)
+///     a   = B⁺(a_r − Ḃη) + (I − B⁺B) z,   B⁺ = Bᵀ(BBᵀ + λ²I)⁻¹                 (eq. 30, damped)
+///     z   = −k_N η − k_P Sᵀ W (q − q_posture)    (W selects the posture joints)
+///     τ   = (SᵀS)⁻¹ Sᵀ rne_nominal(q, Sη, Sa + Ṡη)                              (eq. 21)
+///
+/// with B = J_v(q) S(q) (3×m, eq. 29), Ḃη = J̇q̇ + J_v Ṡ η at q̇ = Sη, and P the solution of
+/// the Lyapunov equation A_cᵀP + PA_c = −I₆, A_c = [0 I; −K₀ −K₁]. ε = 0 is the paper's
+/// discontinuous unit vector; ε > 0 the boundary-layer variant. For paper5's posture term
+/// (0, 0, q₄ − q₄(0), q₅ − q₅(0)) W = diag(0, 0, 0, 1, 1): Sᵀ maps it to η's slots.
+///
+/// Everything the controller knows is its (nominal) model; the plant is another object.
+/// The call is generic over the state's scalar, so duals give the closed loop's exact
+/// Jacobian (rosenbrock4, linearisation).
+///
+///     nhdyn::rac_controller ctrl(nominal.chain, nominal.constraint, gains, q0, mask);
+///     Eigen::Vector4d tau = ctrl(q, eta, r_measured, circle(t));
+#include <Eigen/Dense>
+
+#include "../constraints/stages.hpp"
+#include "../detail/ldlt.hpp"
+#include "../kinematics/kinematics.hpp"
+
+namespace nhdyn {
+
+/// r_d(t) and its first two derivatives.
+template <class T>
+struct task_reference {
+  vec3<T> r, rd, rdd;
+};
+
+/// r_d(t) = c + R (u cos(ω t + φ) + v sin(ω t + φ)): paper5's circle is c = (0.35, 0, 0),
+/// R = 1, u = y₀, v = z₀, ω = 2π/20, φ = 0.
+struct circle_reference {
+  Eigen::Vector3d center{0.35, 0, 0}, u{0, 1, 0}, v{0, 0, 1};
+  double radius = 1, omega = 2 * 3.14159265358979323846 / 20, phase = 0;
+
+  template <class T>
+  task_reference<T> operator()(const T& t) const {
+    using std::cos;
+    using std::sin;
+    const T th = T(omega) * t + T(phase), c = cos(th), s = sin(th);
+    const vec3<T> U = u.cast<T>(), V = v.cast<T>();
+    task_reference<T> ref;
+    ref.r = center.cast<T>() + T(radius) * (c * U + s * V);
+    ref.rd = T(radius * omega) * (c * V - s * U);
+    ref.rdd = T(-radius * omega * omega) * (c * U + s * V);
+    return ref;
+  }
+};
+
+/// The robust term's constants (Table III) and the boundary layer ε (0: none).
+struct robust_gains {
+  double alpha = 0, gamma0 = 0, gamma1 = 0.1, gamma2 = 0.2, epsilon = 0;
+};
+
+struct rac_gains {
+  Eigen::Matrix3d K0 = 400 * Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d K1 = 40 * Eigen::Matrix3d::Identity();
+  double lambda = 0.02;  ///< damping of B⁺ [m/s² per rad/s², i.e. units of B]
+  double kN = 4, kP = 4;  ///< null-space damping [1/s] and posture stiffness [1/s²]
+  robust_gains robust{};
+  bool use_robust = true;
+};
+
+/// P with A_cᵀP + PA_c = −I₆, A_c = [0 I; −K₀ −K₁], by the vectorised (Kronecker) linear
+/// system (I ⊗ A_cᵀ + A_cᵀ ⊗ I) vec P = −vec I. Throws numerical_error if A_c is not
+/// Hurwitz (P not positive definite).
+inline Eigen::Matrix<double, 6, 6> lyapunov_P(const Eigen::Matrix3d& K0, const Eigen::Matrix3d& K1) {
+  using M6 = Eigen::Matrix<double, 6, 6>;
+  M6 Ac = M6::Zero();
+  Ac.topRightCorner<3, 3>().setIdentity();
+  Ac.bottomLeftCorner<3, 3>() = -K0;
+  Ac.bottomRightCorner<3, 3>() = -K1;
+  Eigen::Matrix<double, 36, 36> L = Eigen::Matrix<double, 36, 36>::Zero();
+  const M6 I = M6::Identity(), At = Ac.transpose();
+  for (int j = 0; j < 6; ++j) L.block<6, 6>(6 * j, 6 * j) += At;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) L.block<6, 6>(6 * i, 6 * j) += At(i, j) * I;
+  const M6 minusI = -I;
+  const Eigen::Matrix<double, 36, 1> p =
+      L.fullPivLu().solve(Eigen::Map<const Eigen::Matrix<double, 36, 1>>(minusI.data()));
+  M6 P = Eigen::Map<const M6>(p.data());
+  P = (0.5 * (P + P.transpose())).eval();
+  if (Eigen::SelfAdjointEigenSolver<M6>(P).eigenvalues().minCoeff() <= 0 || !P.allFinite())
+    throw numerical_error("controller gains: A_c = [0 I; −K₀ −K₁] is not Hurwitz (no positive-definite P)");
+  return P;
+}
+
+template <class S, int N, class C>
+class rac_controller {
+ public:
+  static constexpr int M = C::m_at_compile_time;
+
+  /// nominal: the controller's model; posture_mask: 1 for joints the posture term holds at
+  /// q_posture (paper5: joints 4 and 5), 0 elsewhere; task_link: the link carrying r (its
+  /// frame origin; default the last).
+  rac_controller(const chain<S, N>& nominal, C c, rac_gains g, vecN<double, N> q_posture,
+                 vecN<double, N> posture_mask, int task_link = -1)
+      : c_(c), kin_(nominal), id_(inverse_dynamics(nominal, c)), g_(std::move(g)),
+        P_(lyapunov_P(g_.K0, g_.K1)), q_posture_(std::move(q_posture)), mask_(std::move(posture_mask)),
+        link_(task_link < 0 ? nominal.dof() : task_link) {
+    if (!(g_.lambda >= 0) || !(g_.kN >= 0) || !(g_.kP >= 0) || !(g_.robust.epsilon >= 0) ||
+        !(g_.robust.alpha >= 0 && g_.robust.alpha < 1))
+      throw input_error("controller gains: need λ, k_N, k_P, ε ≥ 0 and 0 ≤ α < 1");
+  }
+  const Eigen::Matrix<double, 6, 6>& P() const { return P_; }
+  const rac_gains& gains() const { return g_; }
+
+  /// The robust term δ(e) (eq. 26–28).
+  template <class T>
+  vec3<T> delta(const Eigen::Matrix<T, 6, 1>& e) const {
+    using std::sqrt;
+    const auto& rb = g_.robust;
+    const vec3<T> w = -(P_.template cast<T>() * e).template tail<3>();  // Hᵀ P e, H = [0; −I]
+    const T e2 = e.squaredNorm(), w2 = w.squaredNorm();
+    if (!g_.use_robust || value_of(w2) == 0) return vec3<T>::Zero();
+    const T ne = value_of(e2) == 0 ? T(0) : T(sqrt(e2));
+    const T rho = (T(rb.gamma2) * e2 + T(rb.gamma1) * ne + T(rb.gamma0)) / T(1 - rb.alpha);
+    const T nw = sqrt(w2);
+    const T den = value_of(nw) >= rb.epsilon ? nw : T(rb.epsilon);
+    return vec3<T>(-rho * w / den);
+  }
+
+  /// τ (m entries) for the state (q, η), the measured task point r and the reference.
+  template <class T>
+  vecN<T, M> operator()(const vecN<T, N>& q, const vecN<T, M>& eta, const vec3<T>& r,
+                        const task_reference<T>& ref) const {
+    const vecN<T, N> qd = apply_S(c_, q, eta);
+    const Eigen::Matrix<T, 3, N> Jv = kin_.jacobian(q, link_).template topRows<3>();
+    const auto Sq = c_.S(q);
+    const Eigen::Matrix<T, 3, M> B = Jv * Sq;                                       // eq. 29
+    const vec3<T> Bdot_eta = kin_.jdot_qdot(q, qd, link_).linear + Jv * apply_Sdot(c_, q, qd, eta);
+    Eigen::Matrix<T, 6, 1> e;
+    e << ref.r - r, ref.rd - B * eta;
+    const vec3<T> a_r = ref.rdd + g_.K1.template cast<T>() * e.template tail<3>() +
+                        g_.K0.template cast<T>() * e.template head<3>() + delta(e);  // eq. 23
+    Eigen::Matrix3d l2 = g_.lambda * g_.lambda * Eigen::Matrix3d::Identity();
+    const Eigen::Matrix<T, 3, 3> G = B * B.transpose() + l2.cast<T>();
+    const auto f = ldlt_factor<T, 3>(G, "B Bᵀ + λ²I");
+    const Eigen::Matrix<T, M, 3> Bp = B.transpose() * f.solve(Eigen::Matrix<T, 3, 3>::Identity());
+    const vecN<T, N> dq = (mask_.template cast<T>().array() * (q - q_posture_.template cast<T>()).array()).matrix();
+    const vecN<T, M> z = -T(g_.kN) * eta - T(g_.kP) * apply_St(c_, q, dq);
+    const vecN<T, M> a = Bp * (a_r - Bdot_eta) + z - Bp * (B * z);                 // eq. 30
+    return id_(q, eta, a);                                                          // eq. 21
+  }
+
+  /// The task point r(q) on the controller's model.
+  template <class T>
+  vec3<T> task_point(const vecN<T, N>& q) const {
+    return kin_.point(q, link_);
+  }
+
+ private:
+  C c_;
+  kinematics<S, N> kin_;
+  decltype(inverse_dynamics(std::declval<const chain<S, N>&>(), std::declval<const C&>())) id_;
+  rac_gains g_;
+  Eigen::Matrix<double, 6, 6> P_;
+  vecN<double, N> q_posture_, mask_;
+  int link_;
+};
+
+}  // namespace nhdyn

@@ -1,0 +1,318 @@
+#pragma once
+/// \file simulation/scene.hpp
+/// Scenes (one run) and studies (runs over scenes) as JSON files; docs/simulation.md has
+/// the format. Every field is optional except where noted; defaults are paper-circle's
+/// numbers (paper5.md). Unknown fields are errors naming the field ("scene 'x': unknown
+/// field 'controller.K2'"), so a typo never falls back to a default silently.
+///
+///     scene  = {"name", "description", "robot": "paper5", "plant": factors, "model": factors,
+///               "controller": {...}, "reference": {...}, "initial": {"q", "eta"},
+///               "integrator": {...}, "duration", "sampling": {...}, "noise": {...},
+///               "output": {"step"}, "success": {"tail_from", "max_tail_error"}}
+///     study  = {"name", "description", "study": {"base": scene | "scene name",
+///               "set": {JSON merge patch}, "factors": [{"name", "path", "levels"}]}}
+///               → the full factorial over the factors' levels (path: a JSON pointer)
+///     suite  = {"name", "description", "scenes": [scene | study | suite | "name", …]}
+///
+///     auto runs = nhdyn::scene::expand(nhdyn::scene::load("paper-factorial"));  // 16 run_specs
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "../io/json.hpp"
+#include "simulation.hpp"
+
+namespace nhdyn::scene {
+
+using json = nlohmann::json;
+
+namespace detail {
+/// A JSON object at a dotted path, checked against its allowed keys on construction.
+struct object {
+  const json& j;
+  std::string where;  // "scene 'x': "
+  std::string path;   // "controller.robust"
+
+  object(const json& j_, std::string where_, std::string path_, std::initializer_list<const char*> allowed)
+      : j(j_), where(std::move(where_)), path(std::move(path_)) {
+    if (!j.is_object()) throw input_error(where + "field '" + path + "' must be an object");
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      bool ok = false;
+      for (const char* a : allowed) ok = ok || it.key() == a;
+      if (!ok) {
+        std::string known;
+        for (const char* a : allowed) known += (known.empty() ? "" : ", ") + std::string(a);
+        throw input_error(where + "unknown field '" + name(it.key()) + "' (known here: " + known + ")");
+      }
+    }
+  }
+  std::string name(const std::string& k) const { return path.empty() ? k : path + "." + k; }
+  bool has(const char* k) const { return j.contains(k); }
+  double number(const char* k, double fallback) const {
+    if (!has(k)) return fallback;
+    const json& v = j.at(k);
+    if (!v.is_number() || !std::isfinite(v.get<double>()))
+      throw input_error(where + "field '" + name(k) + "' must be a finite number");
+    return v.get<double>();
+  }
+  std::string text(const char* k, const std::string& fallback) const {
+    if (!has(k)) return fallback;
+    if (!j.at(k).is_string()) throw input_error(where + "field '" + name(k) + "' must be a string");
+    return j.at(k).get<std::string>();
+  }
+  bool boolean(const char* k, bool fallback) const {
+    if (!has(k)) return fallback;
+    if (!j.at(k).is_boolean()) throw input_error(where + "field '" + name(k) + "' must be true or false");
+    return j.at(k).get<bool>();
+  }
+  Eigen::VectorXd vector(const char* k, int n) const {
+    const json& v = j.at(k);
+    if (!v.is_array() || int(v.size()) != n)
+      throw input_error(where + "field '" + name(k) + "' must be a list of " + std::to_string(n) + " numbers");
+    Eigen::VectorXd x(n);
+    for (int i = 0; i < n; ++i) {
+      if (!v[std::size_t(i)].is_number() || !std::isfinite(v[std::size_t(i)].get<double>()))
+        throw input_error(where + "field '" + name(k) + "', entry " + std::to_string(i) + ": must be a finite number");
+      x(i) = v[std::size_t(i)].get<double>();
+    }
+    return x;
+  }
+  /// A gain: a number (times I₃) or a list of 3 (a diagonal).
+  Eigen::Matrix3d gain(const char* k, const Eigen::Matrix3d& fallback) const {
+    if (!has(k)) return fallback;
+    if (j.at(k).is_number()) return number(k, 0) * Eigen::Matrix3d::Identity();
+    return Eigen::Vector3d(vector(k, 3)).asDiagonal();
+  }
+  object sub(const char* k, std::initializer_list<const char*> allowed) const {
+    static const json empty = json::object();
+    return object(has(k) ? j.at(k) : empty, where, name(k), allowed);
+  }
+};
+
+inline presets::paper5_parameters<double> read_factors(const object& o) {
+  presets::paper5_parameters<double> p;
+  if (o.has("mass_factor")) {
+    const Eigen::VectorXd m = o.vector("mass_factor", 5);
+    for (int i = 0; i < 5; ++i) p.mass_factor[std::size_t(i)] = m(i);
+  }
+  p.d3_factor = o.number("d3_factor", 1);
+  p.a4_factor = o.number("a4_factor", 1);
+  p.a5_factor = o.number("a5_factor", 1);
+  return p;
+}
+constexpr std::initializer_list<const char*> factor_keys = {"mass_factor", "d3_factor", "a4_factor", "a5_factor"};
+}  // namespace detail
+
+/// One run from a scene object (see the file comment).
+inline run_spec parse_run(const json& j) {
+  const std::string name = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : "";
+  const std::string where = "scene '" + (name.empty() ? "(unnamed)" : name) + "': ";
+  const detail::object o(j, where, "",
+                         {"name", "description", "robot", "plant", "model", "controller", "reference", "initial",
+                          "integrator", "duration", "sampling", "noise", "output", "success"});
+  run_spec s;
+  if (name.empty()) throw input_error(where + "field 'name' (a string) is required");
+  s.name = name;
+  if (const auto robot = o.text("robot", "paper5"); robot != "paper5")
+    throw input_error(where + "field 'robot': only the preset 'paper5' is simulated (got '" + robot + "')");
+  if (o.has("plant")) s.plant = detail::read_factors(o.sub("plant", detail::factor_keys));
+  if (o.has("model")) s.model = detail::read_factors(o.sub("model", detail::factor_keys));
+
+  const auto c = o.sub("controller", {"K0", "K1", "lambda", "kN", "kP", "posture_joints", "robust"});
+  s.gains.K0 = c.gain("K0", s.gains.K0);
+  s.gains.K1 = c.gain("K1", s.gains.K1);
+  s.gains.lambda = c.number("lambda", s.gains.lambda);
+  s.gains.kN = c.number("kN", s.gains.kN);
+  s.gains.kP = c.number("kP", s.gains.kP);
+  if (c.has("posture_joints")) {
+    const json& pj = c.j.at("posture_joints");
+    if (!pj.is_array()) throw input_error(where + "field 'controller.posture_joints' must be a list of joint numbers 1…5");
+    s.posture_mask.setZero();
+    for (const auto& k : pj) {
+      if (!k.is_number_integer() || k.get<int>() < 1 || k.get<int>() > 5)
+        throw input_error(where + "field 'controller.posture_joints': entries are joint numbers 1…5");
+      s.posture_mask(k.get<int>() - 1) = 1;
+    }
+  }
+  const auto rb = c.sub("robust", {"enabled", "alpha", "gamma0", "gamma1", "gamma2", "epsilon"});
+  s.gains.use_robust = rb.boolean("enabled", true);
+  s.gains.robust = {rb.number("alpha", 0), rb.number("gamma0", 0), rb.number("gamma1", 0.1),
+                    rb.number("gamma2", 0.2), rb.number("epsilon", 0)};
+
+  const auto r = o.sub("reference", {"type", "center", "u", "v", "radius", "period", "phase"});
+  if (const auto type = r.text("type", "circle"); type != "circle")
+    throw input_error(where + "field 'reference.type': only 'circle' is known (got '" + type + "')");
+  if (r.has("center")) s.reference.center = r.vector("center", 3);
+  if (r.has("u")) s.reference.u = r.vector("u", 3);
+  if (r.has("v")) s.reference.v = r.vector("v", 3);
+  s.reference.radius = r.number("radius", s.reference.radius);
+  const double period = r.number("period", 20);
+  if (!(period != 0)) throw input_error(where + "field 'reference.period' must not be 0");
+  s.reference.omega = 2 * 3.14159265358979323846 / period;
+  s.reference.phase = r.number("phase", 0);
+
+  const auto init = o.sub("initial", {"q", "eta"});
+  if (init.has("q")) s.q0 = init.vector("q", 5);
+  if (init.has("eta")) s.eta0 = init.vector("eta", 4);
+
+  const auto in = o.sub("integrator", {"method", "step", "rtol", "atol", "max_steps", "min_step"});
+  s.integrator.kind = method_from_string(in.text("method", to_string(s.integrator.kind)));
+  s.integrator.step = in.number("step", s.integrator.step);
+  s.integrator.rtol = in.number("rtol", s.integrator.rtol);
+  s.integrator.atol = in.number("atol", s.integrator.atol);
+  s.integrator.max_steps = long(in.number("max_steps", double(s.integrator.max_steps)));
+  s.integrator.min_step = in.number("min_step", s.integrator.min_step);
+  if (!(s.integrator.step > 0) || !(s.integrator.rtol > 0) || !(s.integrator.atol > 0) ||
+      !(s.integrator.max_steps > 0) || !(s.integrator.min_step >= 0))
+    throw input_error(where + "field 'integrator': step, rtol, atol, max_steps must be > 0");
+
+  s.duration = o.number("duration", s.duration);
+  const auto sm = o.sub("sampling", {"mode", "rate_hz"});
+  const std::string mode = sm.text("mode", sm.has("rate_hz") ? "zoh" : "continuous");
+  if (mode == "continuous") {
+    if (sm.has("rate_hz")) throw input_error(where + "field 'sampling.rate_hz' needs sampling.mode 'zoh'");
+    s.sample_rate = 0;
+  } else if (mode == "zoh") {
+    s.sample_rate = sm.number("rate_hz", 0);
+    if (!(s.sample_rate > 0)) throw input_error(where + "field 'sampling.rate_hz' must be > 0 for mode 'zoh'");
+  } else {
+    throw input_error(where + "field 'sampling.mode' must be 'continuous' or 'zoh' (got '" + mode + "')");
+  }
+  const auto nz = o.sub("noise", {"sigma", "seed"});
+  s.noise_sigma = nz.number("sigma", 0);
+  if (nz.has("seed")) {
+    if (!nz.j.at("seed").is_number_integer() || nz.j.at("seed").get<long long>() < 0)
+      throw input_error(where + "field 'noise.seed' must be a non-negative integer");
+    s.seed = nz.j.at("seed").get<std::uint64_t>();
+  }
+  s.output_step = o.sub("output", {"step"}).number("step", s.output_step);
+  const auto su = o.sub("success", {"tail_from", "max_tail_error"});
+  s.tail_from = su.number("tail_from", s.tail_from);
+  s.tail_tolerance = su.number("max_tail_error", s.tail_tolerance);
+  if (!(s.duration > 0) || !(s.output_step > 0) || !(s.noise_sigma >= 0))
+    throw input_error(where + "duration and output.step must be > 0 and noise.sigma ≥ 0");
+  return s;
+}
+
+/// Where shipped scenes are looked for: $NHDYN_SCENES_DIR, then examples/scenes under the
+/// current directory and its parents, then under the executable's directory and parents.
+inline std::vector<std::filesystem::path> scene_dirs() {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> dirs;
+  if (const char* e = std::getenv("NHDYN_SCENES_DIR")) dirs.emplace_back(e);
+#ifdef NHDYN_SCENES_INSTALL_DIR
+  dirs.emplace_back(NHDYN_SCENES_INSTALL_DIR);
+#endif
+  std::error_code ec;
+  std::vector<fs::path> starts{fs::current_path(ec)};
+  if (const auto exe = fs::read_symlink("/proc/self/exe", ec); !ec) starts.push_back(exe.parent_path());
+  for (auto p : starts)
+    for (; !p.empty(); p = p.parent_path()) {
+      dirs.push_back(p / "examples" / "scenes");
+      if (p == p.parent_path()) break;
+    }
+  return dirs;
+}
+
+/// A scene, study or suite from a file path or a shipped scene's name.
+inline json load(const std::string& name_or_path) {
+  namespace fs = std::filesystem;
+  fs::path file;
+  std::error_code ec;
+  if (fs::is_regular_file(name_or_path, ec)) {
+    file = name_or_path;
+  } else {
+    for (const auto& d : scene_dirs())
+      if (fs::is_regular_file(d / (name_or_path + ".json"), ec)) {
+        file = d / (name_or_path + ".json");
+        break;
+      }
+  }
+  if (file.empty())
+    throw input_error("scene '" + name_or_path +
+                      "': no such file, and no shipped scene of that name (looked in examples/scenes; set NHDYN_SCENES_DIR)");
+  std::ifstream f(file);
+  std::stringstream text;
+  text << f.rdbuf();
+  return io::parse_strict<input_error>(text.str(), "scene file '" + file.string() + "': ");
+}
+
+namespace detail {
+inline std::string level_text(const json& v) {
+  if (v.is_number_float()) {
+    std::string s;
+    append_number(s, v.get<double>());
+    return s;
+  }
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
+
+inline void expand_into(const json& j, std::vector<run_spec>& out, int depth) {
+  if (depth > 16) throw input_error("scenes nest more than 16 deep (a suite that includes itself?)");
+  const json resolved = j.is_string() ? load(j.get<std::string>()) : j;
+  if (!resolved.is_object()) throw input_error("a scene must be a JSON object or a scene name");
+  const std::string name = resolved.value("name", std::string("(unnamed)"));
+  const std::string where = "scene '" + name + "': ";
+  if (resolved.contains("scenes")) {
+    const object o(resolved, where, "", {"name", "description", "scenes"});
+    if (!resolved["scenes"].is_array()) throw input_error(where + "field 'scenes' must be a list");
+    for (const auto& s : resolved["scenes"]) expand_into(s, out, depth + 1);
+  } else if (resolved.contains("study")) {
+    const object o(resolved, where, "", {"name", "description", "study"});
+    const object st = o.sub("study", {"base", "set", "factors"});
+    if (!st.has("base")) throw input_error(where + "field 'study.base' is required");
+    json base = st.j["base"].is_string() ? load(st.j["base"].get<std::string>()) : st.j["base"];
+    if (!base.is_object() || base.contains("study") || base.contains("scenes"))
+      throw input_error(where + "field 'study.base' must be a single scene");
+    if (st.has("set")) base.merge_patch(st.j["set"]);
+    const json factors = st.has("factors") ? st.j["factors"] : json::array();
+    if (!factors.is_array()) throw input_error(where + "field 'study.factors' must be a list");
+    std::vector<std::size_t> level(factors.size(), 0);
+    for (std::size_t i = 0; i < factors.size(); ++i) {
+      const object f(factors[i], where, "study.factors[" + std::to_string(i) + "]", {"name", "path", "levels"});
+      if (!f.has("path") || !f.j["path"].is_string() || !f.has("levels") || !f.j["levels"].is_array() ||
+          f.j["levels"].empty())
+        throw input_error(where + "field 'study.factors[" + std::to_string(i) +
+                          "]' needs 'path' (a JSON pointer) and a non-empty list 'levels'");
+    }
+    // Full factorial, first factor slowest (standard order).
+    for (bool more = true; more;) {
+      json run = base;
+      std::string run_name = name;
+      for (std::size_t i = 0; i < factors.size(); ++i) {
+        const auto& f = factors[i];
+        const json& v = f["levels"][level[i]];
+        try {
+          run[json::json_pointer(f["path"].get<std::string>())] = v;
+        } catch (const json::exception& e) {
+          throw input_error(where + "field 'study.factors[" + std::to_string(i) + "].path': " + e.what());
+        }
+        run_name += "-" + f.value("name", f["path"].get<std::string>()) + "_" + level_text(v);
+      }
+      run["name"] = run_name;
+      out.push_back(parse_run(run));
+      more = false;
+      for (std::size_t i = factors.size(); i-- > 0;) {
+        if (++level[i] < factors[i]["levels"].size()) {
+          more = true;
+          break;
+        }
+        level[i] = 0;
+      }
+    }
+  } else {
+    out.push_back(parse_run(resolved));
+  }
+}
+}  // namespace detail
+
+/// The runs of a scene (one), a study (its design) or a suite (all of its members').
+inline std::vector<run_spec> expand(const json& j) {
+  std::vector<run_spec> out;
+  detail::expand_into(j, out, 0);
+  return out;
+}
+
+}  // namespace nhdyn::scene
