@@ -209,6 +209,18 @@ TEST_CASE("model files: save then load is exact, on random chains and the preset
     if (m.constraint) require_same_constraint(*back.constraint, *m.constraint);
     REQUIRE(nhdyn::io::to_string(back) == text);  // saving is deterministic
   }
+  {  // negative zeros keep their sign through save → load → save
+    std::vector<nhdyn::link<double>> L(1);
+    L[0].mass = 1;
+    L[0].inertia = Eigen::Matrix3d::Identity();
+    L[0].theta = -0.0;
+    nhdyn::io::model<double> m{nhdyn::chain<double>(L, Eigen::Vector3d(-0.0, 0, -9.81), "zeros"), std::nullopt, ""};
+    const auto text = nhdyn::io::to_string(m);
+    const auto back = nhdyn::io::parse_model(text);
+    CHECK(std::signbit(back.chain[0].theta));
+    CHECK(std::signbit(back.chain.gravity()(0)));
+    CHECK(nhdyn::io::to_string(back) == text);
+  }
   for (const auto& name : nhdyn::io::preset_names()) {
     const auto m = nhdyn::io::preset(name);
     const auto path = scratch() / (name + "_saved.json");
@@ -233,8 +245,13 @@ TEST_CASE("model files: format_number prints 17 significant digits that read bac
     const double y = json::parse(s).get<double>();
     REQUIRE(std::memcmp(&x, &y, sizeof x) == 0);
   }
-  for (double x : {0.1, 1.0 / 3, 5e-324, 1.7976931348623157e308, -0.0})
-    CHECK(json::parse(nhdyn::io::format_number(x)).get<double>() == x);
+  for (double x : {0.1, 1.0 / 3, 5e-324, 1.7976931348623157e308, -0.0, 0.0, 9.0, -3.0, 1e22, 9007199254740993.0}) {
+    const double y = json::parse(nhdyn::io::format_number(x)).get<double>();
+    CHECK(std::memcmp(&x, &y, sizeof x) == 0);  // the sign of zero too
+  }
+  // dump() prints every number this way, and refuses NaN/Inf rather than writing null.
+  CHECK(nhdyn::io::dump(nhdyn::io::ordered_json{{"a", {0.1, -0.0, 2}}}) == R"({"a": [0.10000000000000001, -0.0, 2]})");
+  CHECK_THROWS_AS(nhdyn::io::dump(json{{"a", {1.0, std::nan("")}}}), nhdyn::numerical_error);
   CHECK_THROWS_AS(nhdyn::io::format_number(std::numeric_limits<double>::infinity()), nhdyn::numerical_error);
   CHECK_THROWS_AS(nhdyn::io::format_number(std::nan("")), nhdyn::numerical_error);
 }

@@ -53,10 +53,12 @@ struct model {
 // Numbers and JSON text
 // ---------------------------------------------------------------------------------------
 
-/// x with 17 significant digits (%.17g): reading it back gives x bit for bit.
+/// x with 17 significant digits (%.17g): reading it back gives x bit for bit (−0 is
+/// written "-0.0" so that a JSON reader keeps its sign).
 /// Throws numerical_error for NaN or Inf, which JSON cannot represent.
 inline std::string format_number(double x) {
   if (!std::isfinite(x)) throw numerical_error(std::isnan(x) ? "result is NaN" : "result is infinite");
+  if (x == 0 && std::signbit(x)) return "-0.0";  // "-0" would read back as the integer 0
   if (x == 0 && std::signbit(x)) return "-0.0";  // "-0" would read back as the integer 0
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.17g", x);
