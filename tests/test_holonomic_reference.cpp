@@ -316,3 +316,45 @@ TEST_CASE("rne: joint angles far from zero and long chains agree with the indepe
   check(nhdyn_ref::random_chain(rng, 12, {.massless_with_inertia = 3, .fully_massless = 7}), 3.1, 3, w_long);
   check(nhdyn_ref::random_chain(rng, 20), 3.1, 2, w_long);
 }
+
+TEST_CASE("rne: the pipeline form id(joint_state) and velocity = false agree with the Lagrangian") {
+  std::mt19937_64 rng(14);
+  const auto c = nhdyn::presets::puma560<double>();
+  const auto ref = nhdyn_ref::from_chain<LD>(c);
+  const auto id = nhdyn::rne(c);
+  for (int s = 0; s < 5; ++s) {
+    nhdyn::joint_state<double, 6> xi;
+    xi.q = random_vector(rng, 6, -3, 3);
+    xi.qd = random_vector(rng, 6, -2, 2);
+    xi.qdd = random_vector(rng, 6, -3, 3);
+    const auto out = id(xi);
+    CHECK(out.q == xi.q);
+    CHECK(rel(out.v, nhdyn_ref::inverse_dynamics<LD>(ref, ld(xi.q), ld(xi.qd), ld(xi.qdd))) < tol);
+    // With velocity = false q̇ is not read (a NaN there is harmless) and v = M q̈ + g.
+    Eigen::Matrix<double, 6, 1> nan_qd = Eigen::Matrix<double, 6, 1>::Constant(std::numeric_limits<double>::quiet_NaN());
+    const auto no_v = id.with({.gravity = true, .velocity = false});
+    CHECK(rel(no_v(xi.q, nan_qd, xi.qdd),
+              nhdyn_ref::inverse_dynamics<LD>(ref, ld(xi.q), ld(xi.qd), ld(xi.qdd), true, false)) < tol);
+  }
+}
+
+TEST_CASE("rne: without gravity the power qdᵀv equals dK/dt of the kinetic energy") {
+  // q̇ᵀ rne_{g=0}(q, q̇, q̈) = dK/dt: kinetic energy alone, exact along the motion.
+  std::mt19937_64 rng(15);
+  worst w("power balance without gravity, / Σ|qd_i v_i|");
+  for (const auto& c : random_chains(rng)) {
+    auto ref = nhdyn_ref::from_chain<LD>(c);
+    ref.gravity.setZero();
+    const auto id = nhdyn::rne(c, {.gravity = false, .velocity = true});
+    const int n = c.dof();
+    for (int s = 0; s < 3; ++s) {
+      const Eigen::VectorXd q = random_vector(rng, n, -3, 3), qd = random_vector(rng, n, -2, 2),
+                            qdd = random_vector(rng, n, -3, 3);
+      const Eigen::VectorXd v = id(q, qd, qdd);
+      const LD dKdt = nhdyn_ref::energy_rate<LD>(ref, ld(q), ld(qd), ld(qdd));
+      const LD scale = std::max((ld(qd).cwiseProduct(ld(v))).cwiseAbs().sum(), LD(1e-300));
+      INFO("chain " << c.name() << ", q = " << q.transpose());
+      CHECK(w(double(std::abs(LD(qd.dot(v)) - dKdt) / scale)) < tol);
+    }
+  }
+}
