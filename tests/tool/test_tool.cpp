@@ -323,6 +323,22 @@ TEST_CASE("tool: --help documents every subcommand; a bad command line is exit s
     INFO(s);
     CHECK(h.out.find(s) != std::string::npos);
   }
+  // Every registered subcommand (listed under "Commands:") has a --help whose text is in
+  // nhdyn --help, so a subcommand added later is documented or this fails.
+  const auto from = h.out.find("Commands:\n");
+  REQUIRE(from != std::string::npos);
+  std::istringstream listing(h.out.substr(from + 10));
+  int listed = 0;
+  for (std::string l; std::getline(listing, l) && !l.empty();) {
+    const std::string name = l.substr(2, l.find(' ', 2) - 2);
+    INFO("subcommand " << name);
+    const auto sub = run_tool(name + " --help", "");
+    CHECK(sub.status == 0);
+    CHECK(sub.out.size() > 40);
+    CHECK(h.out.find(sub.out) != std::string::npos);
+    ++listed;
+  }
+  CHECK(listed >= 2);
   const auto id_help = run_tool("id --help", "");
   CHECK(id_help.status == 0);
   CHECK(id_help.out.find("{\"q\": [n], \"eta\": [m], \"eta_dot\": [m]}") != std::string::npos);
