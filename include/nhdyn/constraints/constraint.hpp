@@ -50,16 +50,18 @@ struct holonomic {
   }
   template <class Q, class E>
   auto S_times(const Eigen::MatrixBase<Q>&, const Eigen::MatrixBase<E>& eta) const {
-    return vecN<typename E::Scalar, N>(eta);
+    return vecN<promote_t<typename Q::Scalar, typename E::Scalar>, N>(
+        eta.template cast<promote_t<typename Q::Scalar, typename E::Scalar>>());
   }
   template <class Q, class V>
   auto St_times(const Eigen::MatrixBase<Q>&, const Eigen::MatrixBase<V>& v) const {
-    return vecN<typename V::Scalar, N>(v);
+    return vecN<promote_t<typename Q::Scalar, typename V::Scalar>, N>(
+        v.template cast<promote_t<typename Q::Scalar, typename V::Scalar>>());
   }
   template <class Q, class QD, class E>
   auto Sdot_times(const Eigen::MatrixBase<Q>&, const Eigen::MatrixBase<QD>&,
                   const Eigen::MatrixBase<E>& eta) const {
-    return vecN<typename E::Scalar, N>::Zero(eta.size());
+    return vecN<promote_t<typename Q::Scalar, typename E::Scalar>, N>::Zero(eta.size());
   }
   static constexpr bool orthonormal_S = true;  // SᵀS = I: the projection is Sᵀ
 };
@@ -194,7 +196,7 @@ struct differential_drive {
   template <class Q, class QD, class E>
   auto Sdot_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
                   const Eigen::MatrixBase<E>& eta) const {
-    using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename E::Scalar>;
+    using T = promote_t<promote_t<promote_t<Sc, typename Q::Scalar>, typename QD::Scalar>, typename E::Scalar>;
     using std::cos;
     using std::sin;
     vecN<T, N> out = vecN<T, N>::Zero(n);
@@ -241,6 +243,7 @@ struct user_constraint {
   template <class Q>
   auto A(const Eigen::MatrixBase<Q>& q) const {
     using T = typename Q::Scalar;
+    detail::check_size(q, n_, "q");
     matrix<T, dynamic, dynamic> a = fA(vecN<T, dynamic>(q));
     check(a, k_, n_, "A(q)");
     return a;
@@ -248,6 +251,7 @@ struct user_constraint {
   template <class Q>
   auto S(const Eigen::MatrixBase<Q>& q) const {
     using T = typename Q::Scalar;
+    detail::check_size(q, n_, "q");
     matrix<T, dynamic, dynamic> s = fS(vecN<T, dynamic>(q));
     check(s, n_, n_ - k_, "S(q)");
     return s;
@@ -258,6 +262,7 @@ struct user_constraint {
     if constexpr (std::is_same_v<FE, std::nullptr_t>) {
       return S(q);
     } else {
+      detail::check_size(q, n_, "q");
       matrix<T, dynamic, dynamic> e = fE(vecN<T, dynamic>(q));
       check(e, n_, n_ - k_, "E(q)");
       return e;
@@ -265,9 +270,12 @@ struct user_constraint {
   }
   template <class Q, class QD>
   auto Sdot(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd) const {
-    using T = typename Q::Scalar;
+    using T = promote_t<typename Q::Scalar, typename QD::Scalar>;
+    detail::check_size(q, n_, "q");
+    detail::check_size(qd, n_, "qd");
     if constexpr (!std::is_same_v<FSdot, std::nullptr_t>) {
-      matrix<T, dynamic, dynamic> s = fSdot(vecN<T, dynamic>(q), vecN<T, dynamic>(qd));
+      matrix<T, dynamic, dynamic> s =
+          fSdot(vecN<T, dynamic>(q.template cast<T>()), vecN<T, dynamic>(qd.template cast<T>()));
       check(s, n_, n_ - k_, "Sdot(q, qd)");
       return s;
     } else {
@@ -321,14 +329,14 @@ auto apply_S(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<
   if constexpr (requires { c.S_times(q, eta); })
     return c.S_times(q, eta);
   else
-    return vecN<typename E::Scalar, C::n_at_compile_time>(c.S(q) * eta);
+    return vecN<promote_t<typename Q::Scalar, typename E::Scalar>, C::n_at_compile_time>(c.S(q) * eta);
 }
 template <class C, class Q, class V>
 auto apply_St(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) {
   if constexpr (requires { c.St_times(q, v); })
     return c.St_times(q, v);
   else
-    return vecN<typename V::Scalar, C::m_at_compile_time>(c.S(q).transpose() * v);
+    return vecN<promote_t<typename Q::Scalar, typename V::Scalar>, C::m_at_compile_time>(c.S(q).transpose() * v);
 }
 template <class C, class Q, class QD, class E>
 auto apply_Sdot(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
@@ -336,7 +344,8 @@ auto apply_Sdot(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBa
   if constexpr (requires { c.Sdot_times(q, qd, eta); })
     return c.Sdot_times(q, qd, eta);
   else
-    return vecN<typename E::Scalar, C::n_at_compile_time>(c.Sdot(q, qd) * eta);
+    return vecN<promote_t<promote_t<typename Q::Scalar, typename QD::Scalar>, typename E::Scalar>,
+                C::n_at_compile_time>(c.Sdot(q, qd) * eta);
 }
 
 }  // namespace nhdyn

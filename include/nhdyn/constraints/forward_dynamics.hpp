@@ -61,7 +61,7 @@ class nh_forward_dynamics_fn : public stage_tag {
   template <class Q, class E, class TAU>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                   const Eigen::MatrixBase<TAU>& tau) const {
-    using T = promote_t<S, typename Q::Scalar>;
+    using T = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
     if constexpr (N == dynamic) {
       detail::check_size(q, c_.dof(), "q");
       detail::check_size(eta, c_.m(), "eta");
@@ -81,6 +81,18 @@ class nh_forward_dynamics_fn : public stage_tag {
     }
     const auto f = ldlt_factor<T, M>(reduced_inertia(q), "the reduced inertia M_η = SᵀMS");
     return vecN<T, M>(f.solve(u - h));
+  }
+
+  /// The state derivative for integrators: x = (q, η) ↦ ẋ = (q̇, η̇) = (S η, η̇), n + m entries.
+  template <class Q, class E, class TAU>
+  auto state_derivative(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
+                        const Eigen::MatrixBase<TAU>& tau) const {
+    const auto eta_dot = (*this)(q, eta, tau);
+    using T = typename decltype(eta_dot)::Scalar;
+    constexpr int NX = N == dynamic || M == dynamic ? dynamic : N + M;
+    vecN<T, NX> dx(c_.dof() + c_.m());
+    dx << apply_S(c_, q, eta).template cast<T>(), eta_dot;
+    return dx;
   }
 
  private:

@@ -8,6 +8,10 @@
 ///
 ///     nonholonomic inverse dynamics = project ∘ rne ∘ lift   (in the code, literally)
 ///
+/// (`inverse_dynamics` adds a resize of ξ between lift and rne only when the constraint
+/// and the chain are sized differently, e.g. a run-time-sized user constraint on a
+/// fixed-size chain; the numbers are the same.)
+///
 /// and the constraint forces λ = (A Aᵀ)⁻¹ A (v − E τ), which do no work (q̇ᵀAᵀλ = 0).
 #include "../detail/ldlt.hpp"
 #include "../dynamics/rne.hpp"
@@ -142,15 +146,42 @@ constraint_forces_fn<C> constraint_forces(C c) {
 
 /// The nonholonomic inverse dynamics τ(q, η, η̇) = project ∘ rne ∘ lift (Theorem 1).
 /// Call it as `id(q, eta, eta_dot)` or `id(reduced_state{…})`.
+namespace detail {
+/// ξ resized to a chain of N joints (N fixed or dynamic) when the constraint is sized
+/// otherwise, e.g. a run-time-sized user constraint on a fixed-size chain.
+template <int N>
+struct resize_fn : stage_tag {
+  template <class X, int M>
+  joint_state<X, N> operator()(const joint_state<X, M>& xi) const {
+    return {xi.q, xi.qd, xi.qdd};
+  }
+};
+template <class S, int N, class C>
+void check_constraint_fits(const chain<S, N>& ch, const C& c) {
+  if (c.dof() != ch.dof())
+    throw model_error("model '" + ch.name() + "': the constraint is over " + std::to_string(c.dof()) +
+                      " joints, the chain has " + std::to_string(ch.dof()));
+}
+/// out ∘ rne ∘ lift, with a resize between lift and rne only where the sizes differ.
+template <class S, int N, class C, class Out>
+auto nh_pipeline(const chain<S, N>& ch, const C& c, rne_options o, Out out) {
+  check_constraint_fits(ch, c);
+  if constexpr (C::n_at_compile_time == N)
+    return compose(std::move(out), rne(ch, o), lift(c));
+  else
+    return compose(std::move(out), rne(ch, o), resize_fn<N>{}, lift(c));
+}
+}  // namespace detail
+
 template <class S, int N, class C>
 auto inverse_dynamics(const chain<S, N>& ch, const C& c, rne_options o = {}) {
-  return compose(project(c), rne(ch, o), lift(c));
+  return detail::nh_pipeline(ch, c, o, project(c));
 }
 
 /// As inverse_dynamics, returning (τ, λ).
 template <class S, int N, class C>
 auto inverse_dynamics_with_forces(const chain<S, N>& ch, const C& c, rne_options o = {}) {
-  return compose(constraint_forces(c), rne(ch, o), lift(c));
+  return detail::nh_pipeline(ch, c, o, constraint_forces(c));
 }
 
 }  // namespace nhdyn
