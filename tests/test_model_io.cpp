@@ -398,3 +398,22 @@ TEST_CASE("model files: unreadable files and unknown presets are clear errors") 
   require_same_chain(nhdyn::io::load((source_dir() / "examples/puma560.json").string()).chain,
                      nhdyn::presets::puma560<double>());
 }
+
+TEST_CASE("model files: parsed text without a source name gives messages without a file part") {
+  json j = paper5_json();
+  j["constraint"]["heading"] = 7;
+  try {
+    nhdyn::io::parse_model(j.dump());
+    FAIL("no error");
+  } catch (const nhdyn::model_error& e) {
+    CHECK(std::string(e.what()).rfind("constraint, field 'heading': joint index 7", 0) == 0);
+  }
+  j = paper5_json();
+  j["links"][1]["a"] = "0";
+  try {
+    nhdyn::io::parse_model(j.dump(), "my robot");
+    FAIL("no error");
+  } catch (const nhdyn::model_error& e) {
+    CHECK(std::string(e.what()).rfind("my robot, link 2, field 'a': expected a number, got string", 0) == 0);
+  }
+}

@@ -282,7 +282,7 @@ link<S> read_link(const json& j, const place& at) {
 
 template <class S>
 differential_drive<S> read_constraint(const json& j, const place& at, int n) {
-  const place c{at.prefix + ", constraint"};
+  const place c{at.prefix + (at.prefix.empty() ? "" : ", ") + "constraint"};
   if (!j.is_object()) throw model_error(at.field("constraint") + "expected an object, got " + describe(j));
   if (!j.contains("type")) throw model_error(c.field("type") + "missing (known types: differential_drive)");
   const auto type = string_field(j["type"], c, "type");
