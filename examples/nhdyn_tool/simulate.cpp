@@ -28,7 +28,7 @@ constexpr std::string_view usage = R"(nhdyn simulate SCENE... --out DIR [--threa
                         scene's output step, from dense output; tau is the torque applied
                         (the held value under zero-order hold), r the plant's true position,
                         err = |r_d - r|; numbers round-trip exact
-    DIR/summary.json    [{name, success, max_tail_error, steps, failure, wall_time_s, peak_tau}]
+    DIR/summary.json    [{name, success, max_tail_error, steps, failure, wall_time_s, cpu_time_s, peak_tau}]
     DIR/<group>-path.png, -error.png, -q.png   figs. 4-6 (gnuplot; one set per scene or study)
   A study's runs go in parallel on --threads workers (default: all cores), with a progress
   bar when stderr is a terminal. Exit status: 0 all runs succeeded, 1 some run failed,
@@ -147,6 +147,7 @@ int run(const std::vector<std::string>& args) {
   const auto t0 = std::chrono::steady_clock::now();
   auto results = nhdyn::run_batch(specs, threads, [&](std::size_t i, nhdyn::run_result& r) {
     const auto tc = std::chrono::steady_clock::now();
+    const double cpu0 = nhdyn::detail::thread_cpu_seconds();
     try {
       nhdyn::write_csv((dir / (r.name + ".csv")).string(), r);
     } catch (const std::exception& e) {
@@ -154,6 +155,7 @@ int run(const std::vector<std::string>& args) {
       r.failure = e.what();
     }
     r.wall_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
+    r.cpu_time_s += nhdyn::detail::thread_cpu_seconds() - cpu0;
     r.rows.resize(0, 0);  // written; free the memory
     const std::lock_guard<std::mutex> lock(m);
     ++done;
@@ -176,6 +178,7 @@ int run(const std::vector<std::string>& args) {
     e["steps"] = r.steps;
     e["failure"] = r.failure ? nlohmann::ordered_json(*r.failure) : nullptr;
     e["wall_time_s"] = r.wall_time_s;
+    e["cpu_time_s"] = r.cpu_time_s;
     e["peak_tau"] = r.peak_tau;
     summary.push_back(e);
   }
@@ -183,22 +186,24 @@ int run(const std::vector<std::string>& args) {
 
   std::size_t width = 4;
   for (const auto& r : results) width = std::max(width, r.name.size());
-  std::cout << std::left << std::setw(int(width)) << "run" << "  ok   tail [mm]  peak|tau| [N]   steps  wall [ms]\n";
+  std::cout << std::left << std::setw(int(width)) << "run" << "  ok   tail [mm]  peak|tau| [N]   steps  wall [ms]  cpu [ms]\n";
   int failed = 0;
   for (const auto& r : results) {
     failed += !r.success;
     std::cout << std::left << std::setw(int(width)) << r.name << "  " << (r.success ? "yes" : "NO ") << std::right
               << std::setw(11) << (std::isfinite(r.max_tail_error) ? fixed(1e3 * r.max_tail_error, 3) : "-")
               << std::setw(15) << fixed(r.peak_tau, 1) << std::setw(8) << r.steps << std::setw(11)
-              << fixed(1e3 * r.wall_time_s, 1) << (r.failure ? "  " + *r.failure : "") << '\n';
+              << fixed(1e3 * r.wall_time_s, 1) << std::setw(10) << fixed(1e3 * r.cpu_time_s, 1) << (r.failure ? "  " + *r.failure : "") << '\n';
   }
   for (const auto& g : groups) {
     int ok = 0;
     for (auto i : g.runs) ok += results[i].success;
     std::cout << g.name << ": " << ok << "/" << g.runs.size() << " succeeded\n";
   }
+  double cpu = 0;
+  for (const auto& r : results) cpu += r.cpu_time_s;
   std::cout << "total: " << int(results.size()) - failed << "/" << results.size() << " succeeded in "
-            << fixed(total, 2) << " s wall (" << (threads ? threads : std::thread::hardware_concurrency())
+            << fixed(total, 2) << " s wall, " << fixed(cpu, 2) << " s cpu (" << (threads ? threads : std::thread::hardware_concurrency())
             << " threads); files in " << dir.string() << '\n';
   if (!o.values.count("no-plots")) plot(dir, groups, names);
   return failed ? 1 : 0;

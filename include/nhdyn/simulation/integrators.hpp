@@ -102,11 +102,6 @@ vecN<double, D> from_ode(const X& s) {
   for (std::size_t i = 0; i < s.size(); ++i) x(Eigen::Index(i)) = s[i];
   return x;
 }
-template <int D>
-bool all_finite(const vecN<double, D>& x) {
-  return x.allFinite();
-}
-
 /// Calls observe for every output time in [t0, t1) (and t1 if `last`), from `at(t)`.
 struct output_cursor {
   std::span<const double> times;
@@ -120,14 +115,13 @@ struct output_cursor {
   }
 };
 
-template <int D>
-std::string describe(const vecN<double, D>& x) {
+inline std::string short_number(double x) {
   std::ostringstream os;
-  os.precision(17);
-  os << "[";
-  for (Eigen::Index i = 0; i < x.size(); ++i) os << (i ? ", " : "") << x(i);
-  return os.str() + "]";
+  os.precision(3);
+  os << x;
+  return os.str();
 }
+
 }  // namespace detail
 
 namespace detail {
@@ -151,9 +145,8 @@ void exact_jacobian(F& f, double t, const vecN<double, D>& x, Eigen::Matrix<doub
 /// on Eigen storage: Boost 1.74's uBLAS, which odeint's own rosenbrock4 stores its state
 /// in, does not compile as C++20 (it calls std::allocator::construct, removed in C++20).
 /// The algorithm, coefficients and controller below are odeint's, line for line, with one
-/// correction: Boost 1.74 has d₄ = +0.0362, where Hairer–Wanner's RODAS (whose
-/// coefficients these are) has d₄ = γ₄ = −0.0362. With +0.0362 a non-autonomous problem
-/// loses the method's order (tests/test_integrators.cpp: a step on ẋ = f(t, x) must equal
+/// correction: Boost 1.74 has d₄ = +0.0362, where the method needs d₄ = −0.0362. With
+/// +0.0362 a non-autonomous problem loses the method's order (tests/test_integrators.cpp: a step on ẋ = f(t, x) must equal
 /// the step on the autonomised system (x, t)' = (f, 1), which holds only with −0.0362).
 template <int D>
 struct rosenbrock4_step {
@@ -280,7 +273,7 @@ integration_result<D> integrate(F&& f, const vecN<double, D>& x0, double t0, dou
     if (res.steps > o.max_steps)
       return "too many steps (more than " + std::to_string(o.max_steps) + ")";
     if (h < o.min_step * std::max(1.0, std::abs(t)))
-      return "step size underflow (h = " + std::to_string(h) + ")";
+      return "step size underflow (h = " + detail::short_number(h) + " s)";
     return std::nullopt;
   };
   try {

@@ -253,7 +253,8 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth) {
   if (depth > 16) throw input_error("scenes nest more than 16 deep (a suite that includes itself?)");
   const json resolved = j.is_string() ? load(j.get<std::string>()) : j;
   if (!resolved.is_object()) throw input_error("a scene must be a JSON object or a scene name");
-  const std::string name = resolved.value("name", std::string("(unnamed)"));
+  const std::string name = resolved.contains("name") && resolved["name"].is_string() ? resolved["name"].get<std::string>()
+                                                                                       : std::string("(unnamed)");
   const std::string where = "scene '" + name + "': ";
   if (resolved.contains("scenes")) {
     const object o(resolved, where, "", {"name", "description", "scenes"});
@@ -266,7 +267,10 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth) {
     json base = st.j["base"].is_string() ? load(st.j["base"].get<std::string>()) : st.j["base"];
     if (!base.is_object() || base.contains("study") || base.contains("scenes"))
       throw input_error(where + "field 'study.base' must be a single scene");
-    if (st.has("set")) base.merge_patch(st.j["set"]);
+    if (st.has("set")) {
+      if (!st.j["set"].is_object()) throw input_error(where + "field 'study.set' must be an object (a JSON merge patch)");
+      base.merge_patch(st.j["set"]);
+    }
     const json factors = st.has("factors") ? st.j["factors"] : json::array();
     if (!factors.is_array()) throw input_error(where + "field 'study.factors' must be a list");
     std::vector<std::size_t> level(factors.size(), 0);
@@ -276,7 +280,22 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth) {
           f.j["levels"].empty())
         throw input_error(where + "field 'study.factors[" + std::to_string(i) +
                           "]' needs 'path' (a JSON pointer) and a non-empty list 'levels'");
+      // A JSON pointer may index an array past its end (it grows): bound the index so that a
+      // typo like /x/100000000000 is an error, not an attempt to allocate it.
+      const std::string p = f.j["path"].get<std::string>();
+      for (std::size_t a = 0; a < p.size();) {
+        const std::size_t b = std::min(p.find('/', a + 1), p.size());
+        const std::string token = p.substr(a + 1, b > a ? b - a - 1 : 0);
+        if (!token.empty() && token.find_first_not_of("0123456789") == std::string::npos && token.size() > 3)
+          throw input_error(where + "field 'study.factors[" + std::to_string(i) + "].path': array index " + token +
+                            " is too large (at most 999)");
+        a = b;
+      }
     }
+    double runs = 1;
+    for (const auto& f : factors) runs *= double(f["levels"].size());
+    if (runs > 1e5)
+      throw input_error(where + "the study's full factorial has " + std::to_string(runs) + " runs (at most 100000)");
     // Full factorial, first factor slowest (standard order).
     for (bool more = true; more;) {
       json run = base;
@@ -289,7 +308,10 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth) {
         } catch (const json::exception& e) {
           throw input_error(where + "field 'study.factors[" + std::to_string(i) + "].path': " + e.what());
         }
-        run_name += "-" + f.value("name", f["path"].get<std::string>()) + "_" + level_text(v);
+        run_name += '-';
+        run_name += f.contains("name") && f["name"].is_string() ? f["name"].get<std::string>() : f["path"].get<std::string>();
+        run_name += '_';
+        run_name += level_text(v);
       }
       run["name"] = run_name;
       out.push_back(parse_run(run));
@@ -311,7 +333,11 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth) {
 /// The runs of a scene (one), a study (its design) or a suite (all of its members').
 inline std::vector<run_spec> expand(const json& j) {
   std::vector<run_spec> out;
-  detail::expand_into(j, out, 0);
+  try {
+    detail::expand_into(j, out, 0);
+  } catch (const json::exception& e) {  // a shape the checks above missed: still an input error
+    throw input_error(std::string("scene: ") + e.what());
+  }
   return out;
 }
 

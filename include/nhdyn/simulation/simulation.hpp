@@ -19,6 +19,7 @@
 #include <charconv>
 #include <chrono>
 #include <cstdint>
+#include <ctime>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -41,7 +42,7 @@ struct run_spec {
   vecN<double, 5> q0 = (vecN<double, 5>() << -0.23710299623923958, 1.0, 3.141592653589793,
                         2.058145585963254, 1.2).finished();
   vecN<double, 4> eta0 = vecN<double, 4>::Zero();
-  integrator_options integrator{method::dopri5, 2e-3, 1e-6, 1e-8};
+  integrator_options integrator{method::dopri5, 2e-3, 1e-5, 1e-7};
   double duration = 20;
   double output_step = 0.01;
   double sample_rate = 0;  ///< Hz; 0 = continuous control
@@ -66,10 +67,22 @@ struct run_result {
   double peak_tau = 0;                 ///< max |τ_i| over the output rows and samples
   long steps = 0;                      ///< accepted integrator steps
   double wall_time_s = 0;
+  double cpu_time_s = 0;  ///< CPU time of the simulating thread (what a loaded machine does not inflate)
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows;  ///< one row per output time
 };
 
 namespace detail {
+/// CPU time of the calling thread [s] (POSIX; wall time where unavailable).
+inline double thread_cpu_seconds() {
+#ifdef CLOCK_THREAD_CPUTIME_ID
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+#else
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+#endif
+}
+
 /// Standard normal numbers from mt19937_64 by Box–Muller: the same sequence on every
 /// platform (std::normal_distribution's algorithm is implementation-defined).
 struct gaussian {
@@ -98,6 +111,7 @@ inline std::string state_text(double t, const vecN<double, 9>& x) {
 /// Throws (model_error, input_error) only for a spec that cannot be set up.
 inline run_result simulate(const run_spec& s) {
   const auto t_start = std::chrono::steady_clock::now();
+  const double cpu_start = detail::thread_cpu_seconds();
   const auto plant = presets::paper5<double>(s.plant);
   const auto nominal = presets::paper5<double>(s.model);
   const kinematics<double, 5> plant_kin(plant.chain);
@@ -203,6 +217,7 @@ inline run_result simulate(const run_spec& s) {
   }
   res.success = !res.failure;
   res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  res.cpu_time_s = detail::thread_cpu_seconds() - cpu_start;
   return res;
 }
 

@@ -1,0 +1,14 @@
+# `nhdyn simulate` end to end: exit status, reason on stdout, CSV header, summary.json.
+if(TARGET nhdyn_tool)
+  set(_sim_check ${CMAKE_CURRENT_SOURCE_DIR}/cli/simulate_check.cmake)
+  add_test(NAME simulate_cli_paper_circle_succeeds
+    COMMAND ${CMAKE_COMMAND} -DTOOL=$<TARGET_FILE:nhdyn_tool> -DSCENE=paper-circle -DRUN=paper-circle
+            -DOUT=${CMAKE_CURRENT_BINARY_DIR}/simulate_cli_ok -DEXPECT_RC=0 "-DEXPECT_TEXT=paper-circle: 1/1 succeeded"
+            -P ${_sim_check})
+  add_test(NAME simulate_cli_failing_run_exits_1_with_reason
+    COMMAND ${CMAKE_COMMAND} -DTOOL=$<TARGET_FILE:nhdyn_tool> -DSCENE=${CMAKE_CURRENT_SOURCE_DIR}/scenes/failing-gains.json
+            -DRUN=failing-gains -DOUT=${CMAKE_CURRENT_BINARY_DIR}/simulate_cli_fail -DEXPECT_RC=1
+            "-DEXPECT_TEXT=too many steps" -P ${_sim_check})
+  set_tests_properties(simulate_cli_paper_circle_succeeds simulate_cli_failing_run_exits_1_with_reason PROPERTIES
+    ENVIRONMENT "NHDYN_SCENES_DIR=${PROJECT_SOURCE_DIR}/examples/scenes")
+endif()
