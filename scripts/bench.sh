@@ -8,7 +8,7 @@
 #
 # Environment: NHDYN_BENCH_BUILD (build dir, default build-bench), NHDYN_BENCH_REPS (5),
 # NHDYN_BENCH_MIN_TIME (seconds per repetition, 0.1), NHDYN_BENCH_FILTER (regex, all),
-# CXX (compiler, default g++).
+# CXX (compiler of a fresh build directory).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${NHDYN_BENCH_BUILD:-$root/build-bench}"
@@ -19,7 +19,8 @@ docs=1
 [ "${1:-}" = "--no-docs" ] && docs=0
 
 "$root/scripts/install-deps.sh"
-cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER="${CXX:-g++}" \
+# CXX, if set, picks the compiler of a fresh build directory (CMake reads it at first configure).
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release \
   -DNHDYN_BUILD_BENCH=ON -DNHDYN_BUILD_TESTS=OFF -DNHDYN_BUILD_EXAMPLES=OFF >/dev/null
 make -C "$build" -j2 nhdyn_bench
 
@@ -35,6 +36,6 @@ echo "bench.sh: wrote $json"
 py=/usr/bin/python3
 [ -x "$py" ] || py=python3
 cpu="$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -1)"
-compiler="$("${CXX:-g++}" --version | head -1)"
+compiler="$("$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")" --version | head -1)"
 "$py" "$root/scripts/perf_table.py" "$json" "$root/docs/performance.md" "$root/docs/performance_scaling.png" \
   --cpu "$cpu" --compiler "$compiler"

@@ -16,7 +16,9 @@
 /// when not given).
 #include <functional>
 #include <sstream>
+#include <utility>
 
+#include "../detail/dh.hpp"
 #include "../model/chain.hpp"
 #include "../scalar/dual.hpp"
 
@@ -124,10 +126,10 @@ struct differential_drive {
     using T = promote_t<Sc, typename Q::Scalar>;
     using std::cos;
     using std::sin;
-    const T p = psi(T(q(heading)));
+    const auto p = detail::sincos_of(psi(T(q(heading))));
     matrix<T, k_at_compile_time, N> a = matrix<T, k_at_compile_time, N>::Zero(1, n);
-    a(0, x) = -sin(p);
-    a(0, y) = cos(p);
+    a(0, x) = -p.s;
+    a(0, y) = p.c;
     return a;
   }
   template <class Q>
@@ -163,10 +165,10 @@ struct differential_drive {
     int c = 0;
     for (int j = 0; j < n; ++j) {
       if (j == lo) {
-        const T p = psi(T(q(heading)));
+        const auto p = detail::sincos_of(psi(T(q(heading))));
         const T v = T(eta(c++));
-        qd(x) = cos(p) * v;
-        qd(y) = sin(p) * v;
+        qd(x) = p.c * v;
+        qd(y) = p.s * v;
       } else if (j != hi) {
         qd(j) = T(eta(c++));
       }
@@ -184,13 +186,38 @@ struct differential_drive {
     int c = 0;
     for (int j = 0; j < n; ++j) {
       if (j == lo) {
-        const T p = psi(T(q(heading)));
-        out(c++) = cos(p) * T(v(x)) + sin(p) * T(v(y));
+        const auto p = detail::sincos_of(psi(T(q(heading))));
+        out(c++) = p.c * T(v(x)) + p.s * T(v(y));
       } else if (j != hi) {
         out(c++) = T(v(j));
       }
     }
     return out;
+  }
+  /// (q̇, q̈) = (S η, S η̇ + Ṡ η) in one pass and one sin/cos of ψ: the lift's work
+  /// (constraints/stages.hpp uses it when a constraint has it).
+  template <class Q, class E, class ED>
+  auto lift_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
+                  const Eigen::MatrixBase<ED>& eta_dot) const {
+    using T = promote_t<promote_t<promote_t<Sc, typename Q::Scalar>, typename E::Scalar>, typename ED::Scalar>;
+    vecN<T, N> qd(n), qdd(n);
+    const int lo = std::min(x, y), hi = std::max(x, y);
+    for (int j = 0, c = 0; j < n; ++j)
+      if (j != lo && j != hi) {
+        qd(j) = T(eta(c));
+        qdd(j) = T(eta_dot(c));
+        ++c;
+      } else if (j == lo) {
+        ++c;
+      }
+    const auto p = detail::sincos_of(psi(T(q(heading))));
+    const T v = T(eta(v_slot())), vd = T(eta_dot(v_slot()));
+    const T wv = T(heading_sign) * qd(heading) * v;  // ψ̇ v
+    qd(x) = p.c * v;
+    qd(y) = p.s * v;
+    qdd(x) = p.c * vd - p.s * wv;
+    qdd(y) = p.s * vd + p.c * wv;
+    return std::pair<vecN<T, N>, vecN<T, N>>{std::move(qd), std::move(qdd)};
   }
   /// Ṡ(q, q̇) η without forming Ṡ: only the v column moves, with ψ̇ = heading_sign·q̇_h.
   template <class Q, class QD, class E>
@@ -200,11 +227,11 @@ struct differential_drive {
     using std::cos;
     using std::sin;
     vecN<T, N> out = vecN<T, N>::Zero(n);
-    const T p = psi(T(q(heading)));
+    const auto p = detail::sincos_of(psi(T(q(heading))));
     const T pd = T(heading_sign) * T(qd(heading));
     const T v = T(eta(v_slot()));
-    out(x) = -sin(p) * pd * v;
-    out(y) = cos(p) * pd * v;
+    out(x) = -p.s * pd * v;
+    out(y) = p.c * pd * v;
     return out;
   }
 

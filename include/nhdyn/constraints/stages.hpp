@@ -39,13 +39,20 @@ class lift_fn : public stage_tag {
       detail::check_size(eta, c_.m(), "eta");
       detail::check_size(eta_dot, c_.m(), "eta_dot");
     }
-    auto qd = apply_S(c_, q, eta);
-    using T = typename decltype(qd)::Scalar;
-    joint_state<T, N> xi;
-    xi.q = q.template cast<T>();
-    xi.qdd = apply_S(c_, q, eta_dot) + apply_Sdot(c_, q, qd, eta);
-    xi.qd = std::move(qd);
-    return xi;
+    if constexpr (requires { c_.lift_times(q, eta, eta_dot); }) {
+      auto [qd, qdd] = c_.lift_times(q, eta, eta_dot);
+      using T = typename decltype(qd)::Scalar;
+      return joint_state<T, N>{q.template cast<T>(), std::move(qd), std::move(qdd)};
+    } else {
+      auto qd = apply_S(c_, q, eta);
+      using T = typename decltype(qd)::Scalar;
+      joint_state<T, N> xi;
+      xi.q = q.template cast<T>();
+      xi.qdd = apply_S(c_, q, eta_dot);  // in place: no temporary for the sum
+      xi.qdd += apply_Sdot(c_, q, qd, eta);
+      xi.qd = std::move(qd);
+      return xi;
+    }
   }
   template <class X, int N, int M>
   auto operator()(const reduced_state<X, N, M>& z) const {
@@ -62,13 +69,16 @@ lift_fn<C> lift(C c) {
 }
 
 namespace detail {
-/// (SᵀE)⁻¹ r, for any right-hand side r of m entries.
+/// (SᵀE)⁻¹ r, for a right-hand side r of m entries (taken by value: with SᵀS = I and no E
+/// it is the answer, returned without a copy).
 template <class C, class Q, class R>
-auto solve_StE(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<R>& r) {
+auto solve_StE(const C& c, const Eigen::MatrixBase<Q>& q, R r) {
   using T = typename R::Scalar;
   constexpr int M = C::m_at_compile_time;
   constexpr bool has_E = requires { c.E(q); };
-  if constexpr (C::orthonormal_S && !has_E) {
+  if constexpr (C::orthonormal_S && !has_E && std::is_same_v<R, vecN<T, M>>) {
+    return r;
+  } else if constexpr (C::orthonormal_S && !has_E) {
     return vecN<T, M>(r);
   } else {
     const auto S = c.S(q);

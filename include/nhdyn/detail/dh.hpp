@@ -7,9 +7,12 @@
 /// i−1; p_i = the vector o_{i−1} → o_i in frame i = (a_i, d_i sin α_i, d_i cos α_i);
 /// z_i = z_{i−1} in frame i = (0, sin α_i, cos α_i).
 #include <cmath>
+#include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "../model/chain.hpp"
+#include "small_buffer.hpp"
 
 namespace nhdyn::detail {
 
@@ -23,6 +26,10 @@ struct dh_link {
   S m{0};
   vec3<S> h = vec3<S>::Zero();   ///< first moment m_i·c_i, frame i
   mat3<S> Io = mat3<S>::Zero();  ///< rotational inertia about o_i, frame i (parallel axis)
+  // The same constants as plain scalars, for the unrolled kernels (no Eigen temporaries):
+  S p0[3] = {S(0), S(0), S(0)};                ///< p_i at d = d0: (a, d0 sin α, d0 cos α)
+  S hs[3] = {S(0), S(0), S(0)};                ///< h
+  S Is[6] = {S(0), S(0), S(0), S(0), S(0), S(0)};  ///< I_o: xx, yy, zz, xy, xz, yz
 };
 
 template <class S>
@@ -45,6 +52,16 @@ dh_link<S> make_dh_link(const link<S>& L) {
   k.h = L.mass * L.com;
   const S cc = L.com.squaredNorm();
   k.Io = L.inertia + L.mass * (cc * mat3<S>::Identity() - L.com * L.com.transpose());  // I_o = I_c + m(|c|²1 − ccᵀ)
+  k.p0[0] = k.a;
+  k.p0[1] = k.d0 * k.sa;
+  k.p0[2] = k.d0 * k.ca;
+  for (int r = 0; r < 3; ++r) k.hs[r] = k.h(r);
+  k.Is[0] = k.Io(0, 0);
+  k.Is[1] = k.Io(1, 1);
+  k.Is[2] = k.Io(2, 2);
+  k.Is[3] = k.Io(0, 1);
+  k.Is[4] = k.Io(0, 2);
+  k.Is[5] = k.Io(1, 2);
   bool zero = is_exact_zero(L.mass);
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) zero = zero && is_exact_zero(L.inertia(r, c));
@@ -86,6 +103,89 @@ joint_geometry<T, S> geometry(const dh_link<S>& k, const T& qi) {
   return {cos(th), sin(th), T(k.d0) + qi};
 }
 
+/// (sin x, cos x) of a double with |x| ≤ 1e5, branch-free (so a loop over it vectorises):
+/// Cody–Waite reduction by π/2 (fdlibm's 33-bit split, exact for these |x|), then fdlibm's
+/// __kernel_sin / __kernel_cos minimax polynomials on [−π/4, π/4] and the quadrant.
+/// Within 1 ulp of glibc's sin/cos (max. abs. difference 1.1e-16, measured over 10⁶ points
+/// per range up to 1e5 — see docs/performance.md); the callers fall back to std::sin/cos
+/// beyond |x| = 1e5 and for NaN/Inf.
+template <class T>
+struct sin_cos {
+  T s, c;
+};
+[[gnu::always_inline]] inline sin_cos<double> sincos_kernel(double x) {
+  constexpr double invpio2 = 6.36619772367581382433e-01;
+  constexpr double pio2_1 = 1.57079632673412561417e+00;   // π/2, first 33 bits
+  constexpr double pio2_1t = 6.07710050650619224932e-11;  // π/2 − pio2_1
+  constexpr double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
+                   S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06,
+                   S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
+  constexpr double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03,
+                   C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07,
+                   C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
+  constexpr double shifter = 6755399441055744.0;  // 1.5·2⁵²: x + shifter − shifter rounds x
+  const double k = (x * invpio2 + shifter) - shifter;  // nearest multiple of π/2
+  const auto quadrant = static_cast<std::int64_t>(k);
+  const double r = (x - k * pio2_1) - k * pio2_1t;  // r ∈ [−π/4, π/4]
+  const double z = r * r;
+  const double sr = r + r * z * (S1 + z * (S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)))));
+  const double hz = 0.5 * z, w = 1.0 - hz;
+  const double cr = w + (((1.0 - w) - hz) + z * z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6))))));
+  const bool swap = (quadrant & 1) != 0;
+  const double s0 = swap ? cr : sr, c0 = swap ? sr : cr;
+  return {(quadrant & 2) ? -s0 : s0, ((quadrant + 1) & 2) ? -c0 : c0};
+}
+/// sin and cos of n doubles, each |x_i| ≤ 1e5 (sincos_kernel over an array).
+inline void sincos_reduced(const double* x, double* s, double* c, int n) {
+  for (int i = 0; i < n; ++i) {
+    const auto r = sincos_kernel(x[i]);
+    s[i] = r.s;
+    c[i] = r.c;
+  }
+}
+
+/// (sin x, cos x) of one angle: sincos_kernel for a double within its range, otherwise
+/// the scalar's own sin and cos.
+template <class T>
+inline sin_cos<T> sincos_of(const T& x) {
+  if constexpr (std::is_same_v<T, double>) {
+    if (std::abs(x) <= 1e5) return sincos_kernel(x);
+  }
+  using std::cos;
+  using std::sin;
+  return {sin(x), cos(x)};
+}
+
+/// cos θ_i and sin θ_i of links 0…n−1 at q (θ_i = θ_i⁰ + q_i for a revolute joint, θ_i⁰
+/// for a prismatic one), all at once: for double by sincos_reduced, otherwise by the
+/// scalar's own cos and sin.
+template <class T, int N, class Links, class Q>
+void joint_angles(const Links& L, const Q& q, int n, T* c, T* s) {
+  using std::cos;
+  using std::sin;
+  const auto theta = [&](int i) {
+    const auto& k = L[static_cast<std::size_t>(i)];
+    return k.revolute ? T(T(k.th0) + T(q(i))) : T(k.th0);
+  };
+  if constexpr (std::is_same_v<T, double>) {
+    small_buffer<double, N> th(n);
+    bool small = true;
+    for (int i = 0; i < n; ++i) {
+      th[i] = theta(i);
+      small = small & (std::abs(th[i]) <= 1e5);  // false for NaN
+    }
+    if (small) {
+      sincos_reduced(th.data(), s, c, n);
+      return;
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    const T t = theta(i);
+    c[i] = cos(t);
+    s[i] = sin(t);
+  }
+}
+
 /// v in frame i−1 → frame i: R_iᵀ v = Rx(α)ᵀ Rz(θ)ᵀ v.
 template <class T, class S>
 vec3<T> rot_T(const dh_link<S>& k, const T& ct, const T& st, const vec3<T>& v) {
@@ -105,6 +205,44 @@ template <class T, class S>
 vec3<T> offset(const dh_link<S>& k, const T& d) {
   return {T(k.a), d * T(k.sa), d * T(k.ca)};
 }
+/// A 3-vector as three plain scalars: the kernels' working type. Eigen's fixed 3-vectors
+/// make the compiler pack 2+1 lanes and go through the stack (store-forwarding stalls);
+/// three scalars stay in registers.
+template <class T>
+struct v3 {
+  T x, y, z;
+};
+template <class T>
+inline v3<T> operator+(const v3<T>& a, const v3<T>& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+template <class T>
+inline v3<T> operator*(const std::type_identity_t<T>& s, const v3<T>& a) {  // T from v3 only: s may be an expression (AutoDiffScalar)
+  return {s * a.x, s * a.y, s * a.z};
+}
+template <class T>
+inline v3<T> cross(const v3<T>& a, const v3<T>& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+/// Rᵀ v (frame i−1 → frame i) with R = Rz(θ) Rx(α).
+template <class T>
+inline v3<T> rot_T(const T& ca, const T& sa, const T& ct, const T& st, const v3<T>& v) {
+  const T uy = ct * v.y - st * v.x;
+  return {ct * v.x + st * v.y, ca * uy + sa * v.z, ca * v.z - sa * uy};
+}
+/// R v (frame i → frame i−1).
+template <class T>
+inline v3<T> rot(const T& ca, const T& sa, const T& ct, const T& st, const v3<T>& v) {
+  const T uy = ca * v.y - sa * v.z;
+  return {ct * v.x - st * uy, st * v.x + ct * uy, sa * v.y + ca * v.z};
+}
+/// I v for a symmetric I given as (xx, yy, zz, xy, xz, yz).
+template <class T, class S>
+inline v3<T> sym_times(const S* I, const v3<T>& v) {
+  return {T(I[0]) * v.x + T(I[3]) * v.y + T(I[4]) * v.z, T(I[3]) * v.x + T(I[1]) * v.y + T(I[5]) * v.z,
+          T(I[4]) * v.x + T(I[5]) * v.y + T(I[2]) * v.z};
+}
+
 /// z_{i−1} in frame i.
 template <class T, class S>
 vec3<T> axis(const dh_link<S>& k) {

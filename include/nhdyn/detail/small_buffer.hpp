@@ -14,7 +14,8 @@ namespace nhdyn::detail {
 template <class T>
 inline constexpr std::size_t inline_capacity = sizeof(T) <= 64 ? 32768 / sizeof(T) : 32;
 
-/// n elements of T, default-initialised. Compile-time N: std::array. Run time: inline
+/// n elements of T, default-initialised (a trivial T is left uninitialised: the algorithms
+/// write every element before they read it, and a call does not pay for zeroing). Compile-time N: std::array. Run time: inline
 /// storage for up to Cap elements (only n of them are constructed), heap beyond.
 template <class T, int N, std::size_t Cap = inline_capacity<T>>
 class small_buffer {
@@ -25,7 +26,7 @@ class small_buffer {
       data_ = heap_.data();
     } else {
       data_ = std::launder(reinterpret_cast<T*>(&inline_));
-      for (int i = 0; i < n; ++i) ::new (static_cast<void*>(data_ + i)) T();
+      for (int i = 0; i < n; ++i) ::new (static_cast<void*>(data_ + i)) T;
       constructed_ = n;
     }
   }
@@ -33,6 +34,7 @@ class small_buffer {
   small_buffer(const small_buffer&) = delete;
   small_buffer& operator=(const small_buffer&) = delete;
   T& operator[](int i) { return data_[i]; }
+  T* data() { return data_; }
 
  private:
   alignas(T) std::byte inline_[sizeof(T) * Cap];
@@ -47,9 +49,10 @@ class small_buffer<T, N, Cap> {
  public:
   explicit small_buffer(int) {}
   T& operator[](int i) { return data_[static_cast<std::size_t>(i)]; }
+  T* data() { return data_.data(); }
 
  private:
-  std::array<T, static_cast<std::size_t>(N)> data_{};
+  std::array<T, static_cast<std::size_t>(N)> data_;
 };
 
 }  // namespace nhdyn::detail

@@ -30,82 +30,91 @@ namespace detail {
 
 template <class T>
 struct rne_scratch {
-  vec3<T> F, Nn;  // net force on link i and net moment about o_i, frame i
-  T ct, st;       // cos θ_i, sin θ_i
+  v3<T> F, Nn;  // net force on link i and net moment about o_i, frame i
 };
 
 /// The recursion. Gravity and Velocity are compile-time so that a call that needs
-/// neither pays for neither.
+/// neither pays for neither. Written on plain scalars (detail::v3): this is the hot loop
+/// of the library, and the benchmark (docs/performance.md) chose this form.
 template <bool Gravity, bool Velocity, class T, int N, class Links, class Q, class QD, class QDD>
 vecN<T, N> rne_kernel(const Links& L, const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd) {
   const int n = static_cast<int>(q.size());
   small_buffer<rne_scratch<T>, N> ws(n);
-  vec3<T> w = vec3<T>::Zero(), dw = vec3<T>::Zero();  // ω_i, ω̇_i  (frame i)
-  vec3<T> acc = Gravity ? vec3<T>(-g) : vec3<T>::Zero();  // a_{o_i} − g (frame i)
+  small_buffer<T, N> cs(n), sn(n);  // cos θ_i, sin θ_i
+  joint_angles<T, N>(L, q, n, cs.data(), sn.data());
+  const T zero(0);
+  v3<T> w{zero, zero, zero}, dw{zero, zero, zero};  // ω_i, ω̇_i  (frame i)
+  v3<T> acc = Gravity ? v3<T>{-g.x(), -g.y(), -g.z()} : v3<T>{zero, zero, zero};  // a_{o_i} − g
   // Forward pass: velocities and accelerations, base to tip.
   for (int i = 0; i < n; ++i) {
     const auto& k = L[static_cast<std::size_t>(i)];
-    const auto [ct, st, d] = geometry(k, T(q(i)));
-    const vec3<T> p = offset<T>(k, d);
+    const T ca(k.ca), sa(k.sa);
+    const T ct = cs[i], st = sn[i];
+    const T qddi(qdd(i));
+    const T d = k.revolute ? T(k.d0) : T(T(k.d0) + T(q(i)));
+    const v3<T> p = k.revolute ? v3<T>{T(k.p0[0]), T(k.p0[1]), T(k.p0[2])} : v3<T>{T(k.a), d * sa, d * ca};
     if (k.revolute) {
       // ω_i = Rᵀ(ω_{i−1} + z q̇_i), ω̇_i = Rᵀ(ω̇_{i−1} + z q̈_i + ω_{i−1} × z q̇_i)
       if constexpr (Velocity) {
-        const T qdi = T(qd(i));
-        dw = rot_T(k, ct, st, vec3<T>(dw.x() + w.y() * qdi, dw.y() - w.x() * qdi, dw.z() + T(qdd(i))));
-        w = rot_T(k, ct, st, vec3<T>(w.x(), w.y(), w.z() + qdi));
-        acc = rot_T(k, ct, st, acc) + dw.cross(p) + w.cross(w.cross(p));
+        const T qdi(qd(i));
+        dw = rot_T(ca, sa, ct, st, v3<T>{dw.x + w.y * qdi, dw.y - w.x * qdi, dw.z + qddi});
+        w = rot_T(ca, sa, ct, st, v3<T>{w.x, w.y, w.z + qdi});
+        acc = rot_T(ca, sa, ct, st, acc) + cross(dw, p) + cross(w, cross(w, p));
       } else {
-        dw = rot_T(k, ct, st, vec3<T>(dw.x(), dw.y(), dw.z() + T(qdd(i))));
-        acc = rot_T(k, ct, st, acc) + dw.cross(p);
+        dw = rot_T(ca, sa, ct, st, v3<T>{dw.x, dw.y, dw.z + qddi});
+        acc = rot_T(ca, sa, ct, st, acc) + cross(dw, p);
       }
     } else {
-      const vec3<T> z = axis<T>(k);
+      // a_i gains z q̈_i (and 2 ω_i × z q̇_i) for a prismatic joint.
+      const v3<T> z{zero, sa, ca};
       if constexpr (Velocity) {
-        w = rot_T(k, ct, st, w);
-        dw = rot_T(k, ct, st, dw);
-        acc = rot_T(k, ct, st, acc) + T(qdd(i)) * z + dw.cross(p) + w.cross(w.cross(p)) +
-              T(2) * T(qd(i)) * w.cross(z);
+        w = rot_T(ca, sa, ct, st, w);
+        dw = rot_T(ca, sa, ct, st, dw);
+        acc = rot_T(ca, sa, ct, st, acc) + qddi * z + cross(dw, p) + cross(w, cross(w, p)) +
+              (T(2) * T(qd(i))) * cross(w, z);
       } else {
-        dw = rot_T(k, ct, st, dw);
-        acc = rot_T(k, ct, st, acc) + T(qdd(i)) * z + dw.cross(p);
+        dw = rot_T(ca, sa, ct, st, dw);
+        acc = rot_T(ca, sa, ct, st, acc) + qddi * z + cross(dw, p);
       }
     }
     auto& s = ws[i];
-    s.ct = ct;
-    s.st = st;
     if (k.inert) {
-      const vec3<T> h = k.h.template cast<T>();
-      const mat3<T> Io = k.Io.template cast<T>();
+      const v3<T> h{T(k.hs[0]), T(k.hs[1]), T(k.hs[2])};
       // F_i = m a_{c_i} = m a_i + ω̇×h + ω×(ω×h);  N_i = I_o ω̇ + ω×(I_o ω) + h×a_i
       if constexpr (Velocity) {
-        s.F = T(k.m) * acc + dw.cross(h) + w.cross(w.cross(h));
-        s.Nn = Io * dw + w.cross(Io * w) + h.cross(acc);
+        s.F = T(k.m) * acc + cross(dw, h) + cross(w, cross(w, h));
+        s.Nn = sym_times<T>(k.Is, dw) + cross(w, sym_times<T>(k.Is, w)) + cross(h, acc);
       } else {
-        s.F = T(k.m) * acc + dw.cross(h);
-        s.Nn = Io * dw + h.cross(acc);
+        s.F = T(k.m) * acc + cross(dw, h);
+        s.Nn = sym_times<T>(k.Is, dw) + cross(h, acc);
       }
     } else {
-      s.F.setZero();
-      s.Nn.setZero();
+      s.F = v3<T>{zero, zero, zero};
+      s.Nn = s.F;
     }
   }
   // Backward pass: f_i = R_{i+1} f_{i+1} + F_i, n_i = R_{i+1} n_{i+1} + p_i × f_i + N_i.
   vecN<T, N> tau(n);
-  vec3<T> f = vec3<T>::Zero(), m = vec3<T>::Zero();
+  v3<T> f{zero, zero, zero}, m{zero, zero, zero};
   for (int i = n - 1; i >= 0; --i) {
     const auto& k = L[static_cast<std::size_t>(i)];
-    auto& s = ws[i];
+    const T ca(k.ca), sa(k.sa);
+    const auto& s = ws[i];
     if (i + 1 < n) {
       const auto& k1 = L[static_cast<std::size_t>(i + 1)];
-      const auto& s1 = ws[i + 1];
-      f = rot(k1, s1.ct, s1.st, f);
-      m = rot(k1, s1.ct, s1.st, m);
+      const T ca1(k1.ca), sa1(k1.sa), ct1 = cs[i + 1], st1 = sn[i + 1];
+      f = rot(ca1, sa1, ct1, st1, f);
+      m = rot(ca1, sa1, ct1, st1, m);
     }
-    const T d = k.revolute ? T(k.d0) : T(k.d0) + T(q(i));
-    f += s.F;
-    m += offset<T>(k, d).cross(f) + s.Nn;
-    const vec3<T> z = axis<T>(k);
-    tau(i) = k.revolute ? T(m.dot(z)) : T(f.dot(z));
+    f = f + s.F;
+    if (k.revolute) {
+      m = m + cross(v3<T>{T(k.p0[0]), T(k.p0[1]), T(k.p0[2])}, f) + s.Nn;
+      tau(i) = sa * m.y + ca * m.z;  // z_{i−1} · n_i
+    } else {
+      const T d = T(k.d0) + T(q(i));
+      m = m + cross(v3<T>{T(k.a), d * sa, d * ca}, f) + s.Nn;
+      tau(i) = sa * f.y + ca * f.z;  // z_{i−1} · f_i
+    }
   }
   return tau;
 }
@@ -168,6 +177,16 @@ class rne_fn : public stage_tag {
   template <class X>
   generalized_forces<promote_t<S, X>, N> operator()(const joint_state<X, N>& xi) const {
     return {xi.q.template cast<promote_t<S, X>>(), (*this)(xi.q, xi.qd, xi.qdd)};
+  }
+  /// Pipeline form on a temporary ξ: q moves on instead of being copied.
+  template <class X>
+  generalized_forces<promote_t<S, X>, N> operator()(joint_state<X, N>&& xi) const {
+    if constexpr (std::is_same_v<promote_t<S, X>, X>) {
+      vecN<X, N> v = (*this)(xi.q, xi.qd, xi.qdd);
+      return {std::move(xi.q), std::move(v)};
+    } else {
+      return (*this)(static_cast<const joint_state<X, N>&>(xi));
+    }
   }
 
   /// The same algorithm with other options.
