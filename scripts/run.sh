@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# The main job: install what is needed, build, and run the paper's example.
+# The main job: install what is needed, build the nhdyn tool, and reproduce the paper's
+# experiment — the circle, then both 16-run studies — printing the summary. Results (CSV per
+# run, summary.json, figures) go to out/paper.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DNHDYN_BUILD_TESTS=OFF >/dev/null
-cmake --build build -j"$(nproc)" --target paper5_id
-./build/examples/paper5_id
+cmake --build build -j"$(nproc)" --target nhdyn_tool
+./build/examples/nhdyn simulate paper --out out/paper
