@@ -9,6 +9,8 @@
 #define NHDYN_TOOL_COMMANDS(X) \
   X(id)                        \
   X(fd)                        \
+  X(linearize)                 \
+  X(bound)                     \
   X(simulate)
 
 #include <iostream>

@@ -66,10 +66,33 @@ class dual {
     for (int k = 0; k < K; ++k) b_[k] = (b_[k] - a_ * o.b_[k]) * inv;
     return *this;
   }
-  friend dual operator+(dual x, const dual& y) { return x += y; }
-  friend dual operator-(dual x, const dual& y) { return x -= y; }
-  friend dual operator*(dual x, const dual& y) { return x *= y; }
-  friend dual operator/(dual x, const dual& y) { return x /= y; }
+  // Binary operators write a fresh result (no aliasing, no zero fill first): the derivative
+  // loops vectorise, which matters for K ≈ 10 (a full Jacobian in one pass).
+  friend dual operator+(const dual& x, const dual& y) {
+    dual r(uninitialized{});
+    r.a_ = x.a_ + y.a_;
+    for (int k = 0; k < K; ++k) r.b_[k] = x.b_[k] + y.b_[k];
+    return r;
+  }
+  friend dual operator-(const dual& x, const dual& y) {
+    dual r(uninitialized{});
+    r.a_ = x.a_ - y.a_;
+    for (int k = 0; k < K; ++k) r.b_[k] = x.b_[k] - y.b_[k];
+    return r;
+  }
+  friend dual operator*(const dual& x, const dual& y) {
+    dual r(uninitialized{});
+    r.a_ = x.a_ * y.a_;
+    for (int k = 0; k < K; ++k) r.b_[k] = x.b_[k] * y.a_ + x.a_ * y.b_[k];
+    return r;
+  }
+  friend dual operator/(const dual& x, const dual& y) {
+    dual r(uninitialized{});
+    const T inv = T(1) / y.a_;
+    r.a_ = x.a_ * inv;
+    for (int k = 0; k < K; ++k) r.b_[k] = (x.b_[k] - r.a_ * y.b_[k]) * inv;
+    return r;
+  }
   friend dual operator-(dual x) {
     x.a_ = -x.a_;
     for (auto& d : x.b_) d = -d;
@@ -151,6 +174,8 @@ class dual {
   }
 
  private:
+  struct uninitialized {};
+  explicit dual(uninitialized) {}
   static T atan_(const T& v) {
     using std::atan;
     return atan(v);

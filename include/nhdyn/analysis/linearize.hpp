@@ -1,0 +1,235 @@
+#pragma once
+/// \file analysis/linearize.hpp
+/// Exact first derivatives of any nhdyn computation by forward-mode duals
+/// (scalar/dual.hpp): no step size, no truncation error, rounding error only.
+///
+/// - `jacobian(f, x)`: ∂f/∂x of any callable f (a user pipeline, a generic lambda) at x.
+///   Columns are seeded K at a time (one pass when x has a fixed size ≤ 16).
+/// - `central_difference_jacobian(f, x, h)`: the same by central differences (2 evaluations
+///   per column, error O(h²) + O(ε/h)), for checks and comparisons.
+/// - `linearize_inverse_dynamics(chain, c, q, η, η̇)`: ∂τ/∂ζ of τ = project∘rne∘lift, with
+///   ζ = (q, η, η̇) and the blocks ∂τ/∂q, ∂τ/∂η, ∂τ/∂η̇ (= M_η when E = S).
+/// - `linearize_forward_dynamics(chain, c, q, η, τ)`: ẋ = f(x, u) with x = (q, η),
+///   f = (S(q)η, η̇(q, η, τ)), u = τ → A = ∂f/∂x, B = ∂f/∂u. For a holonomic chain,
+///   `linearize_forward_dynamics(chain, q, q̇, τ)`: x = (q, q̇), f = (q̇, q̈).
+/// - Parameter sensitivities: build the model from dual parameters inside f, e.g.
+///       jacobian([&](const auto& p) {
+///         using D = typename std::decay_t<decltype(p)>::Scalar;
+///         presets::paper5_parameters<D> par{{p(0), p(1), p(2), p(3), p(4)}, p(5), p(6), p(7)};
+///         const auto r = presets::paper5<D>(par);
+///         return inverse_dynamics(r.chain, r.constraint)(q, eta, eta_dot);
+///       }, ones8);
+///   or `link_parameter_jacobian(chain, c, q, η, η̇)`: ∂τ/∂(m_i, a_i, d_i, I_xx,i, I_yy,i,
+///   I_zz,i) for every link i (columns link by link).
+#include <Eigen/Core>
+#include <type_traits>
+
+#include "../constraints/constraint.hpp"
+#include "../constraints/forward_dynamics.hpp"
+#include "../constraints/stages.hpp"
+#include "../dynamics/forward_dynamics.hpp"
+#include "../scalar/dual.hpp"
+
+namespace nhdyn {
+
+namespace detail {
+/// Dual components per pass: all of x when its size is fixed and ≤ 16, else chunks of 8.
+template <int Nx>
+inline constexpr int seed_chunk = (Nx != dynamic && Nx <= 16) ? Nx : 8;
+
+template <class Y>
+using eigen_vector_of = std::remove_cvref_t<Y>;
+}  // namespace detail
+
+/// ∂f/∂x at x (rows: f's entries, columns: x's), exact to rounding, by duals. f takes an
+/// Eigen vector of duals (same size as x) and returns an Eigen vector whose scalar is a dual
+/// (or anything Eigen converts to one); write f generic (auto parameters).
+template <class F, class X>
+auto jacobian(const F& f, const Eigen::MatrixBase<X>& x) {
+  using T = typename X::Scalar;
+  constexpr int Nx = X::SizeAtCompileTime;
+  constexpr int K = detail::seed_chunk<Nx>;
+  using D = dual<T, K>;
+  using Y = detail::eigen_vector_of<decltype(f(std::declval<const vecN<D, Nx>&>()))>;
+  constexpr int Ny = Y::SizeAtCompileTime;
+  const int n = static_cast<int>(x.size());
+  Eigen::Matrix<T, Ny, Nx> J;
+  vecN<D, Nx> xd(n);
+  for (int c0 = 0; c0 < n; c0 += K) {
+    for (int i = 0; i < n; ++i) xd(i) = D(T(x(i)));
+    for (int k = 0; k < K && c0 + k < n; ++k) xd(c0 + k).derivative(k) = T(1);
+    const Y y = f(xd);
+    if (c0 == 0) J.resize(y.size(), n);
+    for (Eigen::Index r = 0; r < y.size(); ++r)
+      for (int k = 0; k < K && c0 + k < n; ++k) J(r, c0 + k) = D(y(r)).derivative(k);
+  }
+  return J;
+}
+
+/// ∂f/∂x by central differences (f(x + h e_j) − f(x − h e_j)) / 2h, step h·max(1, |x_j|).
+/// f is called with plain vectors of x's scalar.
+template <class F, class X>
+auto central_difference_jacobian(const F& f, const Eigen::MatrixBase<X>& x, double h) {
+  using T = typename X::Scalar;
+  constexpr int Nx = X::SizeAtCompileTime;
+  using Y = detail::eigen_vector_of<decltype(f(std::declval<const vecN<T, Nx>&>()))>;
+  constexpr int Ny = Y::SizeAtCompileTime;
+  const int n = static_cast<int>(x.size());
+  Eigen::Matrix<T, Ny, Nx> J;
+  for (int j = 0; j < n; ++j) {
+    using std::abs;
+    using std::max;
+    const T hj = T(h) * max(T(1), T(abs(T(x(j)))));
+    vecN<T, Nx> xp = x, xm = x;
+    xp(j) += hj;
+    xm(j) -= hj;
+    const Y yp = f(xp), ym = f(xm);
+    if (j == 0) J.resize(yp.size(), n);
+    J.col(j) = (yp - ym) / (T(2) * hj);
+  }
+  return J;
+}
+
+/// ∂τ/∂ζ of the nonholonomic inverse dynamics, ζ = (q, η, η̇) (n + 2m columns).
+template <class T, int N, int M>
+struct inverse_dynamics_jacobian {
+  static constexpr int Z = (N == dynamic || M == dynamic) ? dynamic : N + 2 * M;
+  Eigen::Matrix<T, M, Z> J;  ///< [∂τ/∂q  ∂τ/∂η  ∂τ/∂η̇]
+  int n = N, m = M;
+  auto dq() const { return J.leftCols(n); }
+  auto deta() const { return J.middleCols(n, m); }
+  auto deta_dot() const { return J.rightCols(m); }
+};
+
+namespace detail {
+template <int N, int M>
+inline constexpr int stacked = (N == dynamic || M == dynamic) ? dynamic : N + 2 * M;
+
+template <int Z, class A, class B, class C>
+auto stack3(const A& a, const B& b, const C& c) {
+  using T = typename A::Scalar;
+  vecN<T, Z> z(a.size() + b.size() + c.size());
+  z << a.template cast<T>(), b.template cast<T>(), c.template cast<T>();
+  return z;
+}
+}  // namespace detail
+
+/// ∂τ/∂(q, η, η̇) at (q, η, η̇), by duals through project∘rne∘lift.
+template <class S, int N, class C, class Q, class E, class ED>
+auto linearize_inverse_dynamics(const chain<S, N>& ch, const C& c, const Eigen::MatrixBase<Q>& q,
+                                const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
+                                rne_options o = {}) {
+  constexpr int M = C::m_at_compile_time;
+  constexpr int Z = detail::stacked<N, M>;
+  const int n = c.dof(), m = c.m();
+  if constexpr (N == dynamic) detail::check_size(q, n, "q");
+  detail::check_size(eta, m, "eta");
+  detail::check_size(eta_dot, m, "eta_dot");
+  const auto id = inverse_dynamics(ch, c, o);
+  const auto f = [&](const auto& z) {
+    return id(z.head(n), z.segment(n, m), z.tail(m));
+  };
+  using T = typename Q::Scalar;
+  inverse_dynamics_jacobian<T, N, M> out;
+  out.n = n;
+  out.m = m;
+  out.J = jacobian(f, detail::stack3<Z>(q.template cast<T>(), eta, eta_dot));
+  return out;
+}
+
+/// ẋ = f(x, u) linearised: A = ∂f/∂x, B = ∂f/∂u.
+template <class T, int NX, int NU>
+struct state_space {
+  Eigen::Matrix<T, NX, NX> A;
+  Eigen::Matrix<T, NX, NU> B;
+};
+
+/// x = (q, η), f = (S(q)η, η̇), u = τ for a constrained robot (paper5: 9 states, 4 inputs).
+template <class S, int N, class C, class Q, class E, class TAU>
+auto linearize_forward_dynamics(const chain<S, N>& ch, const C& c, const Eigen::MatrixBase<Q>& q,
+                                const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
+                                rne_options o = {}) {
+  constexpr int M = C::m_at_compile_time;
+  constexpr int Z = detail::stacked<N, M>;
+  constexpr int NX = (N == dynamic || M == dynamic) ? dynamic : N + M;
+  const int n = c.dof(), m = c.m();
+  if constexpr (N == dynamic) detail::check_size(q, n, "q");
+  detail::check_size(eta, m, "eta");
+  detail::check_size(tau, m, "tau");
+  const auto fd = nh_forward_dynamics(ch, c, o);
+  const auto f = [&](const auto& z) {
+    const auto qz = z.head(n);
+    const auto ez = z.segment(n, m);
+    using D = typename std::decay_t<decltype(z)>::Scalar;
+    vecN<D, NX> xdot(n + m);
+    xdot << apply_S(c, qz, ez), fd(qz, ez, z.tail(m));
+    return xdot;
+  };
+  using T = typename Q::Scalar;
+  const auto J = jacobian(f, detail::stack3<Z>(q.template cast<T>(), eta, tau));
+  state_space<T, NX, M> out;
+  out.A = J.leftCols(n + m);
+  out.B = J.rightCols(m);
+  return out;
+}
+
+/// x = (q, q̇), f = (q̇, q̈), u = τ for a holonomic chain.
+template <class S, int N, class Q, class QD, class TAU>
+auto linearize_forward_dynamics(const chain<S, N>& ch, const Eigen::MatrixBase<Q>& q,
+                                const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
+                                rne_options o = {}) {
+  constexpr int Z = N == dynamic ? dynamic : 3 * N;
+  constexpr int NX = N == dynamic ? dynamic : 2 * N;
+  const int n = ch.dof();
+  detail::check_size(q, n, "q");
+  detail::check_size(qd, n, "qd");
+  detail::check_size(tau, n, "tau");
+  const auto fd = forward_dynamics(ch, o);
+  const auto f = [&](const auto& z) {
+    using D = typename std::decay_t<decltype(z)>::Scalar;
+    vecN<D, NX> xdot(2 * n);
+    xdot << z.segment(n, n), fd(z.head(n), z.segment(n, n), z.tail(n));
+    return xdot;
+  };
+  using T = typename Q::Scalar;
+  const auto J = jacobian(f, detail::stack3<Z>(q.template cast<T>(), qd, tau));
+  state_space<T, NX, N> out;
+  out.A = J.leftCols(2 * n);
+  out.B = J.rightCols(n);
+  return out;
+}
+
+/// Names of the 6 per-link parameters of link_parameter_jacobian, in column order.
+inline constexpr const char* link_parameter_names[6] = {"mass", "a", "d", "Ixx", "Iyy", "Izz"};
+
+/// ∂τ/∂π with π = (m_i, a_i, d_i, I_xx,i, I_yy,i, I_zz,i) for i = 1…n (6n columns, link by
+/// link; inertia about the centre of mass, centre of mass held fixed in frame i). τ is the
+/// nonholonomic inverse dynamics (a holonomic<N> constraint gives ∂v/∂π of rne).
+template <int N, class C, class Q, class E, class ED>
+auto link_parameter_jacobian(const chain<double, N>& ch, const C& c, const Eigen::MatrixBase<Q>& q,
+                             const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
+                             rne_options o = {}) {
+  const int n = ch.dof();
+  Eigen::VectorXd pi(6 * n);
+  for (int i = 0; i < n; ++i)
+    pi.segment(6 * i, 6) << ch[i].mass, ch[i].a, ch[i].d, ch[i].inertia(0, 0), ch[i].inertia(1, 1),
+        ch[i].inertia(2, 2);
+  const auto f = [&](const auto& p) {
+    using D = typename std::decay_t<decltype(p)>::Scalar;
+    typename chain<D, N>::links_type L{};
+    if constexpr (N == dynamic) L.resize(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      auto& l = L[static_cast<std::size_t>(i)];
+      l = ch[i].template cast<D>();
+      l.mass = p(6 * i);
+      l.a = p(6 * i + 1);
+      l.d = p(6 * i + 2);
+      for (int r = 0; r < 3; ++r) l.inertia(r, r) = p(6 * i + 3 + r);
+    }
+    const chain<D, N> cd(std::move(L), ch.gravity().template cast<D>(), ch.name(), ch.validation_policy());
+    return vecN<D, C::m_at_compile_time>(inverse_dynamics(cd, c, o)(q, eta, eta_dot));
+  };
+  return jacobian(f, pi);
+}
+
+}  // namespace nhdyn

@@ -1,0 +1,222 @@
+// Exact linearisation by duals, checked against two independent references:
+//  - central finite differences in double over a sweep of steps (the error must follow
+//    the O(h²) truncation law at large h and reach ≈1e-9 at the best step), and
+//  - central finite differences in 50-digit arithmetic (step 1e-20: truncation 1e-40),
+//    which are the derivatives to ≥ 30 digits: the dual Jacobian must agree to 1e-9 relative
+//    (in fact to a few ulps), and a dual<mp50> Jacobian to 1e-30.
+#include <catch2/catch.hpp>
+#include <nhdyn/analysis/linearize.hpp>
+#include <nhdyn/nhdyn.hpp>
+#include <nhdyn/scalar/multiprecision.hpp>
+
+namespace {
+using nhdyn::mp50;
+using V5 = Eigen::Matrix<double, 5, 1>;
+using V4 = Eigen::Matrix<double, 4, 1>;
+using V13 = Eigen::Matrix<double, 13, 1>;
+
+const V5 q0(0.1, -0.2, 0.7, 0.4, -0.9);
+const V4 eta0(0.3, 0.5, 1.2, -0.7), etad0(0.2, -0.3, 1.0, 0.5);
+
+/// τ(ζ) of paper5, generic over the scalar of ζ (a model in the same scalar).
+template <class Z>
+auto paper5_tau(const Z& z) {
+  using T = typename Z::Scalar;
+  const auto r = nhdyn::presets::paper5<T>();
+  return nhdyn::vecN<T, 4>(nhdyn::inverse_dynamics(r.chain, r.constraint)(z.head(5), z.segment(4 + 1, 4), z.tail(4)));
+}
+
+template <class A, class B>
+double rel_err(const A& a, const B& b) {
+  return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
+}
+
+/// 50-digit central differences of τ(ζ), converted to double.
+Eigen::Matrix<double, 4, 13> mp_reference(const V13& z) {
+  const Eigen::Matrix<mp50, 13, 1> zm = z.cast<mp50>();
+  const auto f = [](const Eigen::Matrix<mp50, 13, 1>& x) { return paper5_tau(x); };
+  const auto J = nhdyn::central_difference_jacobian(f, zm, 1e-20);
+  return J.unaryExpr([](const mp50& v) { return static_cast<double>(v); });
+}
+}  // namespace
+
+TEST_CASE("linearize: dtau/dzeta of paper5 by duals matches 50-digit finite differences to 1e-9") {
+  const auto r = nhdyn::presets::paper5();
+  const auto lin = nhdyn::linearize_inverse_dynamics(r.chain, r.constraint, q0, eta0, etad0);
+  V13 z;
+  z << q0, eta0, etad0;
+  const auto ref = mp_reference(z);
+  INFO("dual J:\n" << lin.J << "\nmp50 FD:\n" << ref);
+  CHECK(rel_err(lin.J, ref) < 1e-9);
+  CHECK(rel_err(lin.J, ref) < 1e-13);  // duals are exact up to rounding: a few ulps
+  // ∂τ/∂η̇ is the reduced inertia M_η = SᵀMS (E = S, SᵀS = I): an independent CRBA path.
+  const auto Me = nhdyn::nh_forward_dynamics(r.chain, r.constraint).reduced_inertia(q0);
+  CHECK(rel_err(lin.deta_dot(), Me) < 1e-13);
+  // τ does not depend on the base position (q₁, q₂): translation invariance in the ground plane.
+  CHECK(lin.dq().leftCols(2).cwiseAbs().maxCoeff() < 1e-12);
+}
+
+TEST_CASE("linearize: duals in 50 digits agree with 50-digit finite differences to 1e-30") {
+  V13 z;
+  z << q0, eta0, etad0;
+  const Eigen::Matrix<mp50, 13, 1> zm = z.cast<mp50>();
+  const auto Jd = nhdyn::jacobian([](const auto& x) { return paper5_tau(x); }, zm);
+  // Step 1e-17 ≈ ε₅₀^(1/3): truncation ≈ h² ≈ 1e-34, rounding ≈ ε₅₀/h ≈ 1e-33. The
+  // differences are taken through dual<mp50, 1> numbers with zero derivative part, so that
+  // both sides evaluate the very same model (a real type snaps cos α ≈ 6e-17 of α = −π/2 to
+  // 0, a dual keeps it for ∂/∂α: in 50 digits that difference would show).
+  using D1 = nhdyn::dual<mp50, 1>;
+  const auto fvalue = [](const Eigen::Matrix<mp50, 13, 1>& x) {
+    const Eigen::Matrix<D1, 13, 1> xd = x.unaryExpr([](const mp50& v) { return D1(v); });
+    return Eigen::Matrix<mp50, 4, 1>(paper5_tau(xd).unaryExpr([](const D1& d) { return d.value(); }));
+  };
+  const auto Jf = nhdyn::central_difference_jacobian(fvalue, zm, 1e-17);
+  mp50 worst = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 13; ++j) worst = std::max(worst, mp50(abs(Jd(i, j) - Jf(i, j))));
+  INFO("max |dual − FD| in 50 digits: " << static_cast<double>(worst));
+  CHECK(static_cast<double>(worst) < 1e-30);
+}
+
+TEST_CASE("linearize: central differences over a step sweep converge to the dual Jacobian") {
+  const auto r = nhdyn::presets::paper5();
+  const auto lin = nhdyn::linearize_inverse_dynamics(r.chain, r.constraint, q0, eta0, etad0);
+  V13 z;
+  z << q0, eta0, etad0;
+  const auto f = [](const auto& x) { return paper5_tau(x); };
+  std::vector<double> err;
+  for (double h : {1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8}) {
+    err.push_back(rel_err(nhdyn::central_difference_jacobian(f, z, h), lin.J));
+    INFO("h = " << h << ": error " << err.back());
+  }
+  // Truncation regime: the error falls ≈ 100× per 10× smaller step (O(h²)).
+  CHECK(err[1] < err[0] / 30);
+  CHECK(err[2] < err[1] / 30);
+  // Best step ≈ ε^(1/3) ≈ 1e-5: ≈ 1e-10; the dual Jacobian has no step to choose.
+  CHECK(*std::min_element(err.begin(), err.end()) < 1e-8);
+  // Rounding regime: too small a step is worse again (ε/h).
+  CHECK(err.back() > *std::min_element(err.begin(), err.end()));
+}
+
+TEST_CASE("linearize: A and B of paper5's forward dynamics match 50-digit finite differences") {
+  const auto r = nhdyn::presets::paper5();
+  const V4 tau = nhdyn::inverse_dynamics(r.chain, r.constraint)(q0, eta0, etad0);
+  const auto ss = nhdyn::linearize_forward_dynamics(r.chain, r.constraint, q0, eta0, tau);
+  REQUIRE(ss.A.rows() == 9);
+  REQUIRE(ss.B.cols() == 4);
+  // Reference: f(x, u) = (Sη, η̇) in 50 digits, central differences.
+  const auto rm = nhdyn::presets::paper5<mp50>();
+  const auto fdm = nhdyn::nh_forward_dynamics(rm.chain, rm.constraint);
+  const auto f = [&](const Eigen::Matrix<mp50, 13, 1>& x) {
+    Eigen::Matrix<mp50, 9, 1> out;
+    out << nhdyn::apply_S(rm.constraint, x.head(5), x.segment(5, 4)), fdm(x.head(5), x.segment(5, 4), x.tail(4));
+    return out;
+  };
+  Eigen::Matrix<double, 13, 1> x;
+  x << q0, eta0, tau;
+  const auto J = nhdyn::central_difference_jacobian(f, Eigen::Matrix<mp50, 13, 1>(x.cast<mp50>()), 1e-20);
+  const Eigen::MatrixXd Jd = J.unaryExpr([](const mp50& v) { return static_cast<double>(v); });
+  CHECK(rel_err(ss.A, Jd.leftCols(9)) < 1e-9);
+  CHECK(rel_err(ss.B, Jd.rightCols(4)) < 1e-9);
+  // Structure: ∂(Sη)/∂η = S, ∂(Sη)/∂τ = 0, ∂η̇/∂τ = M_η⁻¹.
+  CHECK(rel_err(ss.A.block(0, 5, 5, 4), r.constraint.S(q0)) < 1e-15);
+  CHECK(ss.B.topRows(5).cwiseAbs().maxCoeff() == 0.0);
+  const Eigen::Matrix4d Me = nhdyn::nh_forward_dynamics(r.chain, r.constraint).reduced_inertia(q0);
+  CHECK(rel_err(ss.B.bottomRows(4) * Me, Eigen::Matrix4d::Identity()) < 1e-12);
+}
+
+TEST_CASE("linearize: a holonomic chain gives x = (q, qd), A = [0 I; dqdd/dq dqdd/dqd], B = [0; M^-1]") {
+  const auto p = nhdyn::presets::puma560();
+  using V6 = Eigen::Matrix<double, 6, 1>;
+  const V6 q(0.3, -0.8, 1.1, 0.2, -0.5, 0.9), qd(0.5, -0.3, 0.8, -1.0, 0.4, 0.7), tau(1, 20, 3, 0.1, 0.2, 0.05);
+  const auto ss = nhdyn::linearize_forward_dynamics(p, q, qd, tau);
+  REQUIRE(ss.A.rows() == 12);
+  CHECK((ss.A.topLeftCorner(6, 6)).cwiseAbs().maxCoeff() == 0.0);
+  CHECK((ss.A.topRightCorner(6, 6) - Eigen::Matrix<double, 6, 6>::Identity()).cwiseAbs().maxCoeff() == 0.0);
+  const Eigen::Matrix<double, 6, 6> M = nhdyn::mass_matrix(p)(q);
+  CHECK(rel_err(M * ss.B.bottomRows(6), Eigen::Matrix<double, 6, 6>::Identity()) < 1e-10);
+  // ∂q̈/∂(q, q̇) against 50-digit central differences.
+  const auto pm = nhdyn::presets::puma560<mp50>();
+  const auto fdm = nhdyn::forward_dynamics(pm);
+  const auto f = [&](const Eigen::Matrix<mp50, 12, 1>& x) {
+    return Eigen::Matrix<mp50, 6, 1>(fdm(x.head(6), x.tail(6), tau.cast<mp50>()));
+  };
+  Eigen::Matrix<double, 12, 1> x;
+  x << q, qd;
+  const auto J = nhdyn::central_difference_jacobian(f, Eigen::Matrix<mp50, 12, 1>(x.cast<mp50>()), 1e-20);
+  const Eigen::MatrixXd Jd = J.unaryExpr([](const mp50& v) { return static_cast<double>(v); });
+  CHECK(rel_err(ss.A.bottomRows(6), Jd) < 1e-9);
+}
+
+TEST_CASE("linearize: parameter sensitivities of paper5's torques by a dual-parameter model") {
+  // ∂τ/∂(mass factors 1…5, d₃, a₄, a₅ factors) with presets::paper5<dual>(seeded factors).
+  const auto sens = [&](const auto& p) {
+    using D = typename std::decay_t<decltype(p)>::Scalar;
+    nhdyn::presets::paper5_parameters<D> par{{p(0), p(1), p(2), p(3), p(4)}, p(5), p(6), p(7)};
+    const auto r = nhdyn::presets::paper5<D>(par);
+    return nhdyn::vecN<D, 4>(nhdyn::inverse_dynamics(r.chain, r.constraint)(q0, eta0, etad0));
+  };
+  const Eigen::Matrix<double, 8, 1> ones = Eigen::Matrix<double, 8, 1>::Ones();
+  const auto J = nhdyn::jacobian(sens, ones);
+  const auto Jm = nhdyn::central_difference_jacobian(sens, Eigen::Matrix<mp50, 8, 1>(ones.cast<mp50>()), 1e-20);
+  const Eigen::MatrixXd Jr = Jm.unaryExpr([](const mp50& v) { return static_cast<double>(v); });
+  INFO("dual:\n" << J << "\nmp50 FD:\n" << Jr);
+  CHECK(rel_err(J, Jr) < 1e-9);
+  // Links 1 and 2 are massless: their mass factors do not matter.
+  CHECK(J.leftCols(2).cwiseAbs().maxCoeff() == 0.0);
+  // τ is linear in each mass factor (inertia scales with it): τ(2·m₃) − τ(m₃) = ∂τ/∂m₃.
+  Eigen::Matrix<double, 8, 1> two = ones;
+  two(2) = 2;
+  CHECK(rel_err(sens(two.cast<mp50>()).unaryExpr([](const mp50& v) { return static_cast<double>(v); }) -
+                    sens(ones.cast<mp50>()).unaryExpr([](const mp50& v) { return static_cast<double>(v); }),
+                J.col(2)) < 1e-12);
+}
+
+TEST_CASE("linearize: link parameter Jacobian matches 50-digit finite differences") {
+  const auto r = nhdyn::presets::paper5();
+  const auto J = nhdyn::link_parameter_jacobian(r.chain, r.constraint, q0, eta0, etad0);
+  REQUIRE(J.cols() == 30);
+  // Reference: the same parameters perturbed in a 50-digit model.
+  const auto c50 = r.chain.cast<mp50>();
+  Eigen::Matrix<double, 4, 30> ref;
+  for (int j = 0; j < 30; ++j) {
+    const int i = j / 6, f = j % 6;
+    const mp50 h = 1e-20;
+    auto tau_at = [&](const mp50& dp) {
+      auto L = c50.links();
+      auto& l = L[static_cast<std::size_t>(i)];
+      if (f == 0) l.mass += dp;
+      if (f == 1) l.a += dp;
+      if (f == 2) l.d += dp;
+      if (f >= 3) l.inertia(f - 3, f - 3) += dp;
+      const nhdyn::chain<mp50, 5> c(L, c50.gravity(), "p", nhdyn::validation{false});  // a lone Izz on a massless link
+      return Eigen::Matrix<mp50, 4, 1>(nhdyn::inverse_dynamics(c, r.constraint)(q0, eta0, etad0));
+    };
+    // Forward differences (a massless link cannot take a negative mass): error O(h) = 1e-20.
+    const Eigen::Matrix<mp50, 4, 1> d = (tau_at(h) - tau_at(mp50(0))) / h;
+    ref.col(j) = d.unaryExpr([](const mp50& v) { return static_cast<double>(v); });
+  }
+  CHECK(rel_err(J, ref) < 1e-9);
+  CHECK(J.cwiseAbs().maxCoeff() > 0.1);  // not all zero
+}
+
+TEST_CASE("linearize: jacobian of a user pipeline with a user stage, and bad sizes are named") {
+  const auto r = nhdyn::presets::paper5();
+  // A user stage after the inverse dynamics: wheel torques from (v, ω) torques.
+  const double radius = 0.1, track = 0.4;
+  const auto wheels = nhdyn::stage([&](const auto& tau) {
+    using T = typename std::decay_t<decltype(tau)>::Scalar;
+    Eigen::Matrix<T, 2, 1> w;
+    w << T(radius / 2) * tau(0) - T(radius / track) * tau(1), T(radius / 2) * tau(0) + T(radius / track) * tau(1);
+    return w;
+  });
+  const auto id = nhdyn::inverse_dynamics(r.chain, r.constraint);
+  const auto pipeline = [&](const auto& e) { return wheels(id(q0, e, etad0)); };
+  const auto J = nhdyn::jacobian(pipeline, eta0);
+  const auto Jf = nhdyn::central_difference_jacobian(pipeline, eta0, 1e-6);
+  CHECK(J.rows() == 2);
+  CHECK(rel_err(J, Jf) < 1e-8);
+  const Eigen::VectorXd bad(3);
+  CHECK_THROWS_WITH(nhdyn::linearize_inverse_dynamics(r.chain, r.constraint, q0, bad, etad0),
+                    Catch::Contains("eta has 3 entries"));
+}
