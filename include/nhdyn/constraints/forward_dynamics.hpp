@@ -50,6 +50,16 @@ class nh_forward_dynamics_fn : public stage_tag {
     return Me;
   }
 
+  /// The 2-norm condition number of M_η(q) (double): how many digits η̇ loses (about
+  /// log10 of it). operator() throws numerical_error when it passes 1/ε; a caller that
+  /// wants to know before (or to switch to a damped model) asks here.
+  template <class Q>
+  double reduced_inertia_condition(const Eigen::MatrixBase<Q>& q) const {
+    detail::check_size(q, c_.dof(), "q");
+    detail::check_finite(q, "q");
+    return condition_number(reduced_inertia(q));
+  }
+
   /// h_η = Sᵀ rne(q, Sη, Ṡη).
   template <class Q, class E>
   auto reduced_bias(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta) const {
@@ -62,11 +72,11 @@ class nh_forward_dynamics_fn : public stage_tag {
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                   const Eigen::MatrixBase<TAU>& tau) const {
     using T = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
-    if constexpr (N == dynamic) {
-      detail::check_size(q, c_.dof(), "q");
-      detail::check_size(eta, c_.m(), "eta");
-      detail::check_size(tau, c_.m(), "tau");
-    }
+    detail::check_size(q, c_.dof(), "q");
+    detail::check_size(eta, c_.m(), "eta");
+    detail::check_size(tau, c_.m(), "tau");
+    detail::check_finite(q, "q");
+    detail::check_finite(eta, "eta");
     detail::check_finite(tau, "tau");
     const vecN<T, M> h = reduced_bias(q, eta);
     vecN<T, M> u;
@@ -80,7 +90,9 @@ class nh_forward_dynamics_fn : public stage_tag {
       u = (Sq.transpose() * Sq).template cast<T>() * tau.template cast<T>();
     }
     const auto f = ldlt_factor<T, M>(reduced_inertia(q), "the reduced inertia M_η = SᵀMS");
-    return vecN<T, M>(f.solve(u - h));
+    vecN<T, M> eta_dot = f.solve(u - h);
+    detail::check_overflow(eta_dot, "nh_forward_dynamics");
+    return eta_dot;
   }
 
   /// The state derivative for integrators: x = (q, η) ↦ ẋ = (q̇, η̇) = (S η, η̇), n + m entries.

@@ -34,11 +34,12 @@ class lift_fn : public stage_tag {
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                   const Eigen::MatrixBase<ED>& eta_dot) const {
     constexpr int N = C::n_at_compile_time;
-    if constexpr (N == dynamic) {
-      detail::check_size(q, c_.dof(), "q");
-      detail::check_size(eta, c_.m(), "eta");
-      detail::check_size(eta_dot, c_.m(), "eta_dot");
-    }
+    detail::check_size(q, c_.dof(), "q");
+    detail::check_size(eta, c_.m(), "eta");
+    detail::check_size(eta_dot, c_.m(), "eta_dot");
+    detail::check_finite(q, "q");
+    detail::check_finite(eta, "eta");
+    detail::check_finite(eta_dot, "eta_dot");
     if constexpr (requires { c_.lift_times(q, eta, eta_dot); }) {
       auto [qd, qdd] = c_.lift_times(q, eta, eta_dot);
       using T = typename decltype(qd)::Scalar;
@@ -87,6 +88,15 @@ auto solve_StE(const C& c, const Eigen::MatrixBase<Q>& q, R r) {
       return vecN<T, M>(ldlt_factor<T, M>(G, "SᵀS").solve(r));
     } else {
       const matrix<T, M, M> G = (S.transpose() * c.E(q)).template cast<T>();
+      // The actuators must produce every admissible motion: SᵀE invertible, and well enough
+      // conditioned that the solve keeps a digit (checked on the double values).
+      const double kappa = condition_number(G);
+      if (!(kappa < 1.0 / 2.220446049250313e-16)) {
+        std::ostringstream os;
+        os << "SᵀE is " << (std::isinf(kappa) ? "singular" : "numerically singular") << " (condition number "
+           << kappa << "): the actuators (E) cannot produce every admissible motion (S)";
+        throw numerical_error(os.str());
+      }
       return vecN<T, M>(Eigen::PartialPivLU<matrix<T, M, M>>(G).solve(r));
     }
   }
@@ -102,7 +112,7 @@ class project_fn : public stage_tag {
   /// τ = (SᵀE)⁻¹ Sᵀ v (m entries).
   template <class Q, class V>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
-    if constexpr (C::n_at_compile_time == dynamic) detail::check_size(v, c_.dof(), "v");
+    detail::check_size(v, c_.dof(), "v");
     return detail::solve_StE(c_, q, apply_St(c_, q, v));
   }
   template <class X, int N>

@@ -7,6 +7,7 @@
 /// i−1; p_i = the vector o_{i−1} → o_i in frame i = (a_i, d_i sin α_i, d_i cos α_i);
 /// z_i = z_{i−1} in frame i = (0, sin α_i, cos α_i).
 #include <cmath>
+#include <limits>
 #include <cstdint>
 #include <type_traits>
 #include <vector>
@@ -40,10 +41,15 @@ dh_link<S> make_dh_link(const link<S>& L) {
   k.revolute = L.joint == joint_type::revolute;
   k.ca = cos(L.alpha);
   k.sa = sin(L.alpha);
-  // Exact zeros where α is a multiple of π/2 in double: keeps the planar cases planar.
-  if constexpr (std::is_floating_point_v<S>) {
-    if (std::abs(k.ca) < 1e-15) k.ca = S(0);
-    if (std::abs(k.sa) < 1e-15) k.sa = S(0);
+  // Exact zeros where α is a multiple of π/2 in double: keeps the planar cases planar. For
+  // every real number type (float … long double, multiprecision), so that a model evaluates
+  // the same in all of them; not for duals (∂/∂α must survive) nor intervals (enclosure).
+  if constexpr (std::is_floating_point_v<S> ||
+                (std::numeric_limits<S>::is_specialized && !std::numeric_limits<S>::is_integer)) {
+    // Snap both: a zero cosine makes the sine ±1 exactly (else cos² + sin² ≠ 1 by ~1e-33,
+    // which a 50-digit evaluation sees as a 1e-32 disagreement between rne and CRBA).
+    if (std::abs(value_of(k.ca)) < 1e-15) k.ca = S(0), k.sa = S(value_of(k.sa) < 0 ? -1 : 1);
+    if (std::abs(value_of(k.sa)) < 1e-15) k.sa = S(0), k.ca = S(value_of(k.ca) < 0 ? -1 : 1);
   }
   k.a = L.a;
   k.d0 = L.d;
@@ -86,6 +92,24 @@ typename dh_links<S, N>::type make_dh_links(const chain<S, N>& c) {
   return out;
 }
 
+/// θ = θ⁰ + q is rounded before sin/cos: at |q| = 1e6 a double loses up to 6e-11 rad of
+/// θ⁰ (a float 0.03 rad), an error of the algorithm, not of the input. For floating-point T
+/// the rounding error e = (θ⁰ + q) − θ is exact (Knuth's TwoSum), and (c, s) of θ are turned
+/// by e: cos/sin of the exact sum. Nothing is done when e = 0 (θ⁰ = 0, or small angles).
+template <class T>
+void correct_angle_sum(const T& a, const T& b, const T& sum, T& c, T& s) {
+  if constexpr (std::is_floating_point_v<T>) {
+    const T bb = sum - a;
+    const T e = (a - (sum - bb)) + (b - bb);
+    if (e != T(0)) {
+      const T ce = std::cos(e), se = std::sin(e);
+      const T c1 = c * ce - s * se;
+      s = s * ce + c * se;
+      c = c1;
+    }
+  }
+}
+
 /// cos θ_i, sin θ_i and d_i of link i at joint value qi.
 template <class T, class S>
 struct joint_geometry {
@@ -97,7 +121,9 @@ joint_geometry<T, S> geometry(const dh_link<S>& k, const T& qi) {
   using std::sin;
   if (k.revolute) {
     const T th = T(k.th0) + qi;
-    return {cos(th), sin(th), T(k.d0)};
+    T c = cos(th), s = sin(th);
+    correct_angle_sum(T(k.th0), qi, th, c, s);
+    return {c, s, T(k.d0)};
   }
   const T th = T(k.th0);
   return {cos(th), sin(th), T(k.d0) + qi};
@@ -156,6 +182,17 @@ inline sin_cos<T> sincos_of(const T& x) {
   return {sin(x), cos(x)};
 }
 
+/// correct_angle_sum for every revolute joint with θ⁰ ≠ 0 (see there).
+template <class T, class Links, class Q>
+void correct_angle_sums(const Links& L, const Q& q, int n, T* c, T* s) {
+  if constexpr (std::is_floating_point_v<T>) {
+    for (int i = 0; i < n; ++i) {
+      const auto& k = L[static_cast<std::size_t>(i)];
+      if (k.revolute && k.th0 != 0) correct_angle_sum(T(k.th0), T(q(i)), T(T(k.th0) + T(q(i))), c[i], s[i]);
+    }
+  }
+}
+
 /// cos θ_i and sin θ_i of links 0…n−1 at q (θ_i = θ_i⁰ + q_i for a revolute joint, θ_i⁰
 /// for a prismatic one), all at once: for double by sincos_reduced, otherwise by the
 /// scalar's own cos and sin.
@@ -176,6 +213,7 @@ void joint_angles(const Links& L, const Q& q, int n, T* c, T* s) {
     }
     if (small) {
       sincos_reduced(th.data(), s, c, n);
+      correct_angle_sums(L, q, n, c, s);
       return;
     }
   }
@@ -184,6 +222,7 @@ void joint_angles(const Links& L, const Q& q, int n, T* c, T* s) {
     c[i] = cos(t);
     s[i] = sin(t);
   }
+  correct_angle_sums(L, q, n, c, s);
 }
 
 /// v in frame i−1 → frame i: R_iᵀ v = Rx(α)ᵀ Rz(θ)ᵀ v.

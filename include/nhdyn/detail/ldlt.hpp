@@ -5,7 +5,11 @@
 /// comparison, so it runs over intervals and duals; it checks pivots on their double
 /// value and reports a (near-)singular matrix with a condition estimate.
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <cmath>
+#include <limits>
+#include <type_traits>
 #include <sstream>
 #include <string>
 
@@ -37,12 +41,24 @@ struct ldlt {
   }
 };
 
+/// 1/ε of T's precision (for float 1.7e7, double 4.5e15, a 50-digit type 1e50; for types
+/// without numeric_limits — duals, intervals — that of double): the pivot ratio past which a
+/// solve in T has no correct digit left.
+template <class T>
+double default_max_pivot_ratio() {
+  if constexpr (std::numeric_limits<T>::is_specialized && !std::numeric_limits<T>::is_integer &&
+                std::is_convertible_v<decltype(std::numeric_limits<T>::epsilon()), double>)
+    return 1.0 / static_cast<double>(std::numeric_limits<T>::epsilon());
+  else
+    return 1.0 / 2.220446049250313e-16;
+}
+
 /// Factorises symmetric positive-definite M (only the lower triangle is read). Throws
 /// numerical_error naming `what` if a pivot is not positive or the pivot ratio exceeds
-/// max_ratio (default: 1/ε of double, where the solution has no correct digit left).
+/// max_ratio (default: 1/ε of T, where the solution has no correct digit left).
 template <class T, int N>
 ldlt<T, N> ldlt_factor(const Eigen::Matrix<T, N, N>& M, const char* what = "matrix",
-                       double max_ratio = 1.0 / 2.220446049250313e-16) {
+                       double max_ratio = default_max_pivot_ratio<T>()) {
   const int n = static_cast<int>(M.rows());
   ldlt<T, N> f;
   f.L = M;
@@ -71,6 +87,19 @@ ldlt<T, N> ldlt_factor(const Eigen::Matrix<T, N, N>& M, const char* what = "matr
     throw numerical_error(os.str());
   }
   return f;
+}
+
+/// The 2-norm condition number σ_max/σ_min of a square matrix, computed in double from the
+/// entries' values (value_of): what a caller checks before trusting a solve with it (∞ if
+/// singular, NaN if an entry is not finite). For a symmetric positive-definite matrix it is
+/// λ_max/λ_min; ldlt::pivot_ratio() is a cheaper lower bound of it.
+template <class Derived>
+double condition_number(const Eigen::MatrixBase<Derived>& A) {
+  const Eigen::MatrixXd a = A.unaryExpr([](const auto& x) { return value_of(x); }).template cast<double>();
+  if (!a.allFinite()) return NAN;
+  if (a.size() == 0) return 1.0;
+  const Eigen::VectorXd s = Eigen::JacobiSVD<Eigen::MatrixXd>(a).singularValues();  // descending
+  return s(s.size() - 1) > 0 ? s(0) / s(s.size() - 1) : INFINITY;
 }
 
 }  // namespace nhdyn

@@ -14,16 +14,24 @@ class forward_dynamics_fn : public stage_tag {
   explicit forward_dynamics_fn(const chain<S, N>& c, rne_options o = {})
       : M_(c), rne_(c, o) {}
 
+  /// The 2-norm condition number of M(q) (double); operator() throws numerical_error past 1/ε.
+  template <class Q>
+  double mass_matrix_condition(const Eigen::MatrixBase<Q>& q) const {
+    return condition_number(M_(q));
+  }
+
   template <class Q, class QD, class TAU>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
                   const Eigen::MatrixBase<TAU>& tau) const {
     using X = typename Q::Scalar;
     using T = promote_t<S, X>;
-    if constexpr (N == dynamic) detail::check_size(tau, rne_.dof(), "tau");
+    detail::check_size(tau, rne_.dof(), "tau");
     detail::check_finite(tau, "tau");
     const vecN<T, N> h = rne_(q, qd, vecN<X, N>::Zero(q.size()));
     const auto f = ldlt_factor<T, N>(M_(q), "the mass matrix M(q)");
-    return vecN<T, N>(f.solve(tau.template cast<T>() - h));
+    vecN<T, N> qdd = f.solve(tau.template cast<T>() - h);
+    detail::check_overflow(qdd, "forward_dynamics");
+    return qdd;
   }
 
  private:

@@ -37,7 +37,8 @@ class mass_matrix_fn : public stage_tag {
   template <class Q>
   auto operator()(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<S, typename Q::Scalar>;
-    if constexpr (N == dynamic) detail::check_size(q, n_, "q");
+    detail::check_size(q, n_, "q");
+    detail::check_finite(q, "q");
     const int n = n_;
     struct frame {
       T ct, st, d;

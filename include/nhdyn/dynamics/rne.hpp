@@ -133,6 +133,15 @@ void check_result(const R& out, const Q& q, const QD& qd, const QDD& qdd, const 
     }
 }
 
+/// Throws numerical_error if a result computed from finite inputs is not finite.
+template <class R>
+void check_overflow(const R& out, const char* algorithm) {
+  for (Eigen::Index i = 0; i < out.size(); ++i)
+    if (!is_finite_scalar(out(i)))
+      throw numerical_error(std::string(algorithm) + ": result " + std::to_string(i) +
+                            " is not finite although every input is (overflow)");
+}
+
 }  // namespace detail
 
 /// The rne function object over a chain (see the file comment).
@@ -155,11 +164,9 @@ class rne_fn : public stage_tag {
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
                   const Eigen::MatrixBase<QDD>& qdd) const {
     using T = promote_t<S, typename Q::Scalar>;
-    if constexpr (N == dynamic) {
-      detail::check_size(q, n_, "q");
-      detail::check_size(qd, n_, "qd");
-      detail::check_size(qdd, n_, "qdd");
-    }
+    detail::check_size(q, n_, "q");
+    detail::check_size(qd, n_, "qd");
+    detail::check_size(qdd, n_, "qdd");
     const vec3<T> g = g_.template cast<T>();
     vecN<T, N> v;
     if (opt_.gravity) {

@@ -49,7 +49,8 @@ class kinematics {
   template <class Q>
   auto forward(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<S, typename Q::Scalar>;
-    if constexpr (N == dynamic) detail::check_size(q, n_, "q");
+    detail::check_size(q, n_, "q");
+    detail::check_finite(q, "q");
     std::vector<pose<T>> X(static_cast<std::size_t>(n_ + 1));
     for (int i = 0; i < n_; ++i) {
       const auto& k = links_[std::size_t(i)];
@@ -103,7 +104,8 @@ class kinematics {
                  const vec3<S>& p_i = vec3<S>::Zero()) const {
     using T = promote_t<S, typename Q::Scalar>;
     check_link(i, true);
-    if constexpr (N == dynamic) detail::check_size(qd, n_, "qd");
+    detail::check_size(qd, n_, "qd");
+    detail::check_finite(qd, "qd");
     vec3<T> w = vec3<T>::Zero(), dw = vec3<T>::Zero(), acc = vec3<T>::Zero();  // frame j
     mat3<T> R = mat3<T>::Identity();                                          // R_0j
     for (int j = 0; j < i; ++j) {
