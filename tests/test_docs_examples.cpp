@@ -407,6 +407,9 @@ TEST_CASE("docs/api.md §9: wrong sizes and non-finite inputs are errors that sa
     CHECK(std::string(e.what()) == "q has 5 entries; the model needs 6");
   }
   CHECK_THROWS_AS(id(Eigen::VectorXd::Zero(5), Eigen::VectorXd::Zero(6), Eigen::VectorXd::Zero(6)), nhdyn::input_error);
+  // Compile-time-sized models check sizes too.
+  const auto id5 = nhdyn::rne(nhdyn::presets::paper5().chain);
+  CHECK_THROWS_AS(id5(Eigen::VectorXd::Zero(4), Eigen::VectorXd::Zero(5), Eigen::VectorXd::Zero(5)), nhdyn::input_error);
   Eigen::VectorXd qd = Eigen::VectorXd::Zero(6);
   qd(2) = std::nan("");
   CHECK_THROWS_AS(id(Eigen::VectorXd::Zero(6), qd, Eigen::VectorXd::Zero(6)), nhdyn::error);
