@@ -9,6 +9,10 @@
 ///     [v; ω] = J q̇,   [a; ω̇] = J q̈ + J̇q̇
 #include <vector>
 
+#include <range/v3/numeric/partial_sum.hpp>
+#include <range/v3/view/iota.hpp>
+#include <range/v3/view/transform.hpp>
+
 #include "../detail/dh.hpp"
 #include "../detail/small_buffer.hpp"
 
@@ -51,14 +55,17 @@ class kinematics {
     using T = promote_t<S, typename Q::Scalar>;
     detail::check_size(q, n_, "q");
     detail::check_finite(q, "q");
-    std::vector<pose<T>> X(static_cast<std::size_t>(n_ + 1));
-    for (int i = 0; i < n_; ++i) {
+    // X_0i = X_0,i−1 · A_i: an inclusive scan of the link transforms (Spong eq. 3.10).
+    const auto A_i = [&](int i) {
       const auto& k = links_[std::size_t(i)];
       const auto [ct, st, d] = detail::geometry(k, T(q(i)));
-      const auto& P = X[std::size_t(i)];
-      X[std::size_t(i + 1)].R = P.R * detail::dh_rotation(k, ct, st);
-      X[std::size_t(i + 1)].p = P.p + P.R * vec3<T>(T(k.a) * ct, T(k.a) * st, d);
-    }
+      return pose<T>{detail::dh_rotation(k, ct, st), vec3<T>(T(k.a) * ct, T(k.a) * st, d)};
+    };
+    const auto then = [](const pose<T>& X_0a, const pose<T>& X_ab) {
+      return pose<T>{X_0a.R * X_ab.R, X_0a.p + X_0a.R * X_ab.p};
+    };
+    std::vector<pose<T>> X(static_cast<std::size_t>(n_ + 1));
+    ranges::partial_sum(ranges::views::iota(0, n_) | ranges::views::transform(A_i), X.begin() + 1, then);
     return X;
   }
 
