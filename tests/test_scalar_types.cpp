@@ -240,7 +240,8 @@ TEST_CASE("scalars: the derivative parts of dual and autodiff identities vanish 
   q(2) = dual2::variable(0.7, 0);
   q(3) = dual2::variable(0.4, 1);
   const auto v = nhdyn::rne(ch)(q, qd, qdd);
-  const auto Mh = nhdyn::mass_matrix(ch)(q) * qdd.cast<dual2>() + nhdyn::bias(ch)(q, qd);
+  // An explicit type: `auto` would keep an Eigen expression referring to the temporary M.
+  const nhdyn::vecN<dual2, 5> Mh = nhdyn::mass_matrix(ch)(q) * qdd.cast<dual2>() + nhdyn::bias(ch)(q, qd);
   for (int i = 0; i < 5; ++i)
     for (int k = 0; k < 2; ++k) CHECK(std::abs(v(i).derivative(k) - Mh(i).derivative(k)) < 1e-12);
   // Eigen::AutoDiffScalar gives the same derivatives as nhdyn::dual.
