@@ -16,6 +16,7 @@
 /// when not given).
 #include <functional>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 #include "../detail/dh.hpp"
@@ -38,6 +39,7 @@ struct holonomic {
   int dof() const { return n; }
   int k() const { return 0; }
   int m() const { return n; }
+  bool depends_on(int) const { return false; }
   template <class Q>
   auto A(const Eigen::MatrixBase<Q>&) const {
     return matrix<typename Q::Scalar, k_at_compile_time, N>(0, n);
@@ -65,6 +67,10 @@ struct holonomic {
                   const Eigen::MatrixBase<E>& eta) const {
     return vecN<promote_t<typename Q::Scalar, typename E::Scalar>, N>::Zero(eta.size());
   }
+  template <class Q, class T>
+  vecN<T, N> St_times_in_place(const Eigen::MatrixBase<Q>&, vecN<T, N>&& v) const {
+    return std::move(v);
+  }
   static constexpr bool orthonormal_S = true;  // SᵀS = I: the projection is Sᵀ
 };
 
@@ -83,6 +89,7 @@ struct differential_drive {
   static constexpr int k_at_compile_time = N == dynamic ? dynamic : 1;
   static constexpr int m_at_compile_time = N == dynamic ? dynamic : N - 1;
   static constexpr bool orthonormal_S = true;  // SᵀS = I
+  using scalar_type = Sc;
 
   int n = N == dynamic ? 0 : N;
   int x = 0, y = 1, heading = 2;
@@ -115,10 +122,12 @@ struct differential_drive {
   int k() const { return 1; }
   int m() const { return n - 1; }
   int v_slot() const { return std::min(x, y); }
+  /// A, S, Ṡ depend on the heading joint only.
+  bool depends_on(int j) const { return j == heading; }
 
   template <class T>
   T psi(const T& qh) const {
-    return T(heading_sign) * qh + T(forward_offset);
+    return T(heading_sign * qh + forward_offset);  // mixed: the constants stay Sc
   }
 
   template <class Q>
@@ -175,6 +184,16 @@ struct differential_drive {
     }
     return qd;
   }
+  /// A v without forming A (k = 1: −sin ψ v_x + cos ψ v_y). A's one row has unit length
+  /// (AAᵀ = 1), so for E = S the constraint force is λ = A v (stages.hpp).
+  template <class Q, class V>
+  auto A_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
+    using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename V::Scalar>;
+    const auto p = detail::sincos_of(psi(T(q(heading))));
+    vecN<T, k_at_compile_time> out(1);
+    out(0) = p.c * T(v(y)) - p.s * T(v(x));
+    return out;
+  }
   /// Sᵀ v without forming S.
   template <class Q, class V>
   auto St_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
@@ -194,13 +213,37 @@ struct differential_drive {
     }
     return out;
   }
-  /// (q̇, q̈) = (S η, S η̇ + Ṡ η) in one pass and one sin/cos of ψ: the lift's work
-  /// (constraints/stages.hpp uses it when a constraint has it).
-  template <class Q, class E, class ED>
-  auto lift_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
-                  const Eigen::MatrixBase<ED>& eta_dot) const {
-    using T = promote_t<promote_t<promote_t<Sc, typename Q::Scalar>, typename E::Scalar>, typename ED::Scalar>;
-    vecN<T, N> qd(n), qdd(n);
+  /// Sᵀ v written over v's own storage (v's first m entries, then v shrinks to m): the
+  /// projection of a temporary v allocates nothing. Sᵀv's entry c reads v's entries ≥ c only.
+  template <class Q, class T>
+  auto St_times_in_place(const Eigen::MatrixBase<Q>& q, vecN<T, N>&& v) const {
+    return St_times_in_place(q, std::move(v), detail::sincos_of(psi(T(q(heading)))));
+  }
+  /// The same with sin/cos of ψ already known (the memo of lift_into).
+  template <class Q, class T>
+  auto St_times_in_place(const Eigen::MatrixBase<Q>&, vecN<T, N>&& v, const detail::sin_cos<T>& p) const {
+    const int lo = std::min(x, y), hi = std::max(x, y);
+    int c = 0;
+    for (int j = 0; j < n; ++j) {
+      if (j == lo)
+        v(c++) = p.c * v(x) + p.s * v(y);
+      else if (j != hi)
+        v(c++) = v(j);
+    }
+    if constexpr (N == dynamic) {
+      v.conservativeResize(n - 1);
+      return std::move(v);
+    } else {
+      return vecN<T, m_at_compile_time>(v.template head<N - 1>());
+    }
+  }
+  /// (q̇, q̈) = (S η, S η̇ + Ṡ η) in one pass and one sin/cos of ψ, written into qd and qdd
+  /// (n entries each): the lift's work (constraints/stages.hpp uses it when a constraint has
+  /// it). Returns sin/cos of ψ, which rides along with ξ as a memo for the projection
+  /// (St_times_in_place).
+  template <class Q, class E, class ED, class T>
+  detail::sin_cos<T> lift_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
+                               const Eigen::MatrixBase<ED>& eta_dot, vecN<T, N>& qd, vecN<T, N>& qdd) const {
     const int lo = std::min(x, y), hi = std::max(x, y);
     for (int j = 0, c = 0; j < n; ++j)
       if (j != lo && j != hi) {
@@ -212,12 +255,12 @@ struct differential_drive {
       }
     const auto p = detail::sincos_of(psi(T(q(heading))));
     const T v = T(eta(v_slot())), vd = T(eta_dot(v_slot()));
-    const T wv = T(heading_sign) * qd(heading) * v;  // ψ̇ v
+    const T wv = T(heading_sign * qd(heading)) * v;  // ψ̇ v
     qd(x) = p.c * v;
     qd(y) = p.s * v;
     qdd(x) = p.c * vd - p.s * wv;
     qdd(y) = p.s * vd + p.c * wv;
-    return std::pair<vecN<T, N>, vecN<T, N>>{std::move(qd), std::move(qdd)};
+    return p;
   }
   /// Ṡ(q, q̇) η without forming Ṡ: only the v column moves, with ψ̇ = heading_sign·q̇_h.
   template <class Q, class QD, class E>
@@ -343,6 +386,16 @@ auto make_constraint(int n, int k, FA fA, FS fS, FSdot fSdot, FE fE) {
 }
 
 // ---- uniform access: structured products where the constraint has them, dense otherwise.
+
+/// Whether A, S, Ṡ or E may depend on q_j: a constraint's `depends_on(j)` where it has one,
+/// else true.
+template <class C>
+bool constraint_depends_on(const C& c, int j) {
+  if constexpr (requires { c.depends_on(j); })
+    return c.depends_on(j);
+  else
+    return true;
+}
 
 template <class C, class Q>
 auto input_map(const C& c, const Eigen::MatrixBase<Q>& q) {

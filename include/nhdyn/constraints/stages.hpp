@@ -23,6 +23,19 @@ namespace nhdyn {
 template <class C>
 using m_of = std::integral_constant<int, C::m_at_compile_time>;
 
+namespace detail {
+/// The scalar of a constraint's own numbers (`scalar_type`), or double.
+template <class C>
+struct constraint_scalar {
+  using type = double;
+};
+template <class C>
+  requires requires { typename C::scalar_type; }
+struct constraint_scalar<C> {
+  using type = typename C::scalar_type;
+};
+}  // namespace detail
+
 template <class C>
 class lift_fn : public stage_tag {
  public:
@@ -40,10 +53,18 @@ class lift_fn : public stage_tag {
     detail::check_finite(q, "q");
     detail::check_finite(eta, "eta");
     detail::check_finite(eta_dot, "eta_dot");
-    if constexpr (requires { c_.lift_times(q, eta, eta_dot); }) {
-      auto [qd, qdd] = c_.lift_times(q, eta, eta_dot);
-      using T = typename decltype(qd)::Scalar;
-      return joint_state<T, N>{q.template cast<T>(), std::move(qd), std::move(qdd)};
+    using TL = promote_t<promote_t<promote_t<typename detail::constraint_scalar<C>::type, typename Q::Scalar>, typename E::Scalar>,
+                         typename ED::Scalar>;
+    if constexpr (requires(vecN<TL, N>& v) { c_.lift_into(q, eta, eta_dot, v, v); }) {
+      // Written in place (the result is returned without a copy).
+      with_memo<joint_state<TL, N>, decltype(c_.lift_into(q, eta, eta_dot, std::declval<vecN<TL, N>&>(),
+                                                          std::declval<vecN<TL, N>&>()))>
+          xi;
+      xi.q = q.template cast<TL>();
+      xi.qd.resize(c_.dof());
+      xi.qdd.resize(c_.dof());
+      xi.memo = c_.lift_into(q, eta, eta_dot, xi.qd, xi.qdd);
+      return xi;
     } else {
       auto qd = apply_S(c_, q, eta);
       using T = typename decltype(qd)::Scalar;
@@ -119,6 +140,27 @@ class project_fn : public stage_tag {
   auto operator()(const generalized_forces<X, N>& f) const {
     return (*this)(f.q, f.v);
   }
+  /// On a temporary (q, v), as inside project ∘ rne ∘ lift: Sᵀv is formed in v's storage
+  /// where the constraint can do that (St_times_in_place).
+  template <class X, int N>
+  auto operator()(generalized_forces<X, N>&& f) const {
+    if constexpr (requires { c_.St_times_in_place(f.q, std::move(f.v)); }) {
+      detail::check_size(f.v, c_.dof(), "v");
+      return detail::solve_StE(c_, f.q, c_.St_times_in_place(f.q, std::move(f.v)));
+    } else {
+      return (*this)(f.q, f.v);
+    }
+  }
+  /// …and with the lift's memo (sin/cos of the heading), where the constraint takes it.
+  template <class X, int N, class Memo>
+  auto operator()(with_memo<generalized_forces<X, N>, Memo>&& f) const {
+    if constexpr (requires { c_.St_times_in_place(f.q, std::move(f.v), f.memo); }) {
+      detail::check_size(f.v, c_.dof(), "v");
+      return detail::solve_StE(c_, f.q, c_.St_times_in_place(f.q, std::move(f.v), f.memo));
+    } else {
+      return (*this)(static_cast<generalized_forces<X, N>&&>(f));
+    }
+  }
 
  private:
   C c_;
@@ -141,6 +183,13 @@ class constraint_forces_fn : public stage_tag {
     using T = typename decltype(tau)::Scalar;
     constexpr int M = C::m_at_compile_time, K = C::k_at_compile_time;
     constrained_forces<T, M, K> out;
+    if constexpr (!requires { c_.E(q); } && requires { c_.A_times(q, v); }) {
+      // E = S: A E τ = A S τ = 0, so λ = (AAᵀ)⁻¹ A v, and a constraint with orthonormal rows
+      // (AAᵀ = I: differential_drive) gives it as a structured product, no matrix formed.
+      out.lambda = c_.A_times(q, v);
+      out.tau = tau;
+      return out;
+    }
     const auto A = c_.A(q);
     const vecN<T, C::n_at_compile_time> r = v.template cast<T>() - (input_map(c_, q) * tau).template cast<T>();
     const matrix<T, K, K> AAt = (A * A.transpose()).template cast<T>();

@@ -27,6 +27,16 @@ struct generalized_forces {
   vecN<S, N> v;
 };
 
+/// A value together with what an earlier stage already evaluated at q, for a later stage
+/// to reuse (differential_drive's lift passes its sin/cos of the heading on to the
+/// projection). It derives from the value, so a stage written for the plain value accepts
+/// it; a stage that builds a new plain value just drops the memo, and the later stage
+/// evaluates the quantity itself. The numbers are the same either way.
+template <class Value, class Memo>
+struct with_memo : Value {
+  Memo memo;
+};
+
 /// τ (actuator forces, m entries) and λ (constraint forces, k entries) at q.
 template <class S, int M = dynamic, int K = dynamic>
 struct constrained_forces {

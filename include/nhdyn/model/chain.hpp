@@ -4,6 +4,8 @@
 /// `chain<S>` has its size at run time; `chain<S, N>` at compile time (N joints), which lets
 /// every algorithm run allocation-free on the stack.
 #include <Eigen/Core>
+#include <bit>
+#include <cstdint>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
@@ -173,24 +175,40 @@ class chain {
 };
 
 namespace detail {
+[[noreturn, gnu::cold, gnu::noinline]] inline void throw_size(Eigen::Index has, int n, const char* what) {
+  std::ostringstream os;
+  os << what << " has " << has << " entries; the model needs " << n;
+  throw input_error(os.str());
+}
 /// Throws input_error if v has not n entries.
 template <class V>
-void check_size(const V& v, int n, const char* what) {
-  if (v.size() != n) {
-    std::ostringstream os;
-    os << what << " has " << v.size() << " entries; the model needs " << n;
-    throw input_error(os.str());
-  }
+inline void check_size(const V& v, int n, const char* what) {
+  if (v.size() != n) [[unlikely]]
+    throw_size(v.size(), n, what);
 }
-/// Throws input_error naming the first non-finite entry of v.
+[[noreturn, gnu::cold, gnu::noinline]] inline void throw_not_finite(const char* what, Eigen::Index i, double x) {
+  std::ostringstream os;
+  os << what << "[" << i << "] is not finite (" << x << ")";
+  throw input_error(os.str());
+}
+/// Throws input_error naming the first non-finite entry of v. For float and double the
+/// common case is one pass over the exponent bits.
 template <class V>
-void check_finite(const V& v, const char* what) {
+inline void check_finite(const V& v, const char* what) {
+  using T = typename V::Scalar;
+  if constexpr (std::is_same_v<T, double> || std::is_same_v<T, float>) {
+    // An IEEE number is finite unless its exponent bits are all ones: integer ORs with a
+    // one-cycle dependency, no floating-point chain.
+    using U = std::conditional_t<std::is_same_v<T, double>, std::uint64_t, std::uint32_t>;
+    constexpr U exp_mask = std::is_same_v<T, double> ? U(0x7ff0000000000000ULL) : U(0x7f800000U);
+    bool bad = false;
+    for (Eigen::Index i = 0; i < v.size(); ++i) bad |= (std::bit_cast<U>(T(v(i))) & exp_mask) == exp_mask;
+    if (!bad) [[likely]]
+      return;
+  }
   for (Eigen::Index i = 0; i < v.size(); ++i)
-    if (!is_finite_scalar(v(i))) {
-      std::ostringstream os;
-      os << what << "[" << i << "] is not finite (" << value_of(v(i)) << ")";
-      throw input_error(os.str());
-    }
+    if (!is_finite_scalar(v(i))) [[unlikely]]
+      throw_not_finite(what, i, value_of(v(i)));
 }
 }  // namespace detail
 
