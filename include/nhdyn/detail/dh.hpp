@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "../model/chain.hpp"
+#include "sincos.hpp"
 #include "small_buffer.hpp"
 
 namespace nhdyn::detail {
@@ -21,9 +22,10 @@ namespace nhdyn::detail {
 template <class S>
 struct dh_link {
   bool revolute = true;
-  bool inert = true;  ///< false: zero mass and zero inertia, the link is skipped
+  bool has_inertia = true;  ///< false: zero mass and zero inertia, the link is skipped
   S ca{1}, sa{0};     ///< cos α_i, sin α_i
   S a{0}, d0{0}, th0{0};
+  S ct0{1}, st0{0};   ///< cos θ⁰, sin θ⁰: a prismatic joint's constant rotation
   S m{0};
   vec3<S> h = vec3<S>::Zero();   ///< first moment m_i·c_i, frame i
   mat3<S> Io = mat3<S>::Zero();  ///< rotational inertia about o_i, frame i (parallel axis)
@@ -54,6 +56,12 @@ dh_link<S> make_dh_link(const link<S>& L) {
   k.a = L.a;
   k.d0 = L.d;
   k.th0 = L.theta;
+  {
+    using std::cos;
+    using std::sin;
+    k.ct0 = cos(L.theta);
+    k.st0 = sin(L.theta);
+  }
   k.m = L.mass;
   k.h = L.mass * L.com;
   const S cc = L.com.squaredNorm();
@@ -71,7 +79,7 @@ dh_link<S> make_dh_link(const link<S>& L) {
   bool zero = is_exact_zero(L.mass);
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) zero = zero && is_exact_zero(L.inertia(r, c));
-  k.inert = !zero;
+  k.has_inertia = !zero;
   return k;
 }
 
@@ -129,53 +137,28 @@ joint_geometry<T, S> geometry(const dh_link<S>& k, const T& qi) {
   return {cos(th), sin(th), T(k.d0) + qi};
 }
 
-/// (sin x, cos x) of a double with |x| ≤ 1e5, branch-free (so a loop over it vectorises):
-/// Cody–Waite reduction by π/2 (fdlibm's 33-bit split, exact for these |x|), then fdlibm's
-/// __kernel_sin / __kernel_cos minimax polynomials on [−π/4, π/4] and the quadrant.
-/// Within 1 ulp of glibc's sin/cos (max. abs. difference 1.1e-16, measured over 10⁶ points
-/// per range up to 1e5 — see docs/performance.md); the callers fall back to std::sin/cos
-/// beyond |x| = 1e5 and for NaN/Inf.
+/// A forward-mode dual number over double (scalar/dual.hpp, or any type shaped like it).
 template <class T>
-struct sin_cos {
-  T s, c;
+concept double_dual = requires(const T& x) {
+  requires std::is_same_v<typename T::value_type, double>;
+  { x.value() } -> std::convertible_to<double>;
+  x.derivatives();
+  chain_rule(x, 0.0, 0.0);
 };
-[[gnu::always_inline]] inline sin_cos<double> sincos_kernel(double x) {
-  constexpr double invpio2 = 6.36619772367581382433e-01;
-  constexpr double pio2_1 = 1.57079632673412561417e+00;   // π/2, first 33 bits
-  constexpr double pio2_1t = 6.07710050650619224932e-11;  // π/2 − pio2_1
-  constexpr double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
-                   S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06,
-                   S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
-  constexpr double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03,
-                   C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07,
-                   C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
-  constexpr double shifter = 6755399441055744.0;  // 1.5·2⁵²: x + shifter − shifter rounds x
-  const double k = (x * invpio2 + shifter) - shifter;  // nearest multiple of π/2
-  const auto quadrant = static_cast<std::int64_t>(k);
-  const double r = (x - k * pio2_1) - k * pio2_1t;  // r ∈ [−π/4, π/4]
-  const double z = r * r;
-  const double sr = r + r * z * (S1 + z * (S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)))));
-  const double hz = 0.5 * z, w = 1.0 - hz;
-  const double cr = w + (((1.0 - w) - hz) + z * z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6))))));
-  const bool swap = (quadrant & 1) != 0;
-  const double s0 = swap ? cr : sr, c0 = swap ? sr : cr;
-  return {(quadrant & 2) ? -s0 : s0, ((quadrant + 1) & 2) ? -c0 : c0};
-}
-/// sin and cos of n doubles, each |x_i| ≤ 1e5 (sincos_kernel over an array).
-inline void sincos_reduced(const double* x, double* s, double* c, int n) {
-  for (int i = 0; i < n; ++i) {
-    const auto r = sincos_kernel(x[i]);
-    s[i] = r.s;
-    c[i] = r.c;
-  }
-}
-
-/// (sin x, cos x) of one angle: sincos_kernel for a double within its range, otherwise
+/// (sin x, cos x) of one angle: sincos_kernel for a double within its range; for a dual
+/// one sin/cos of its value; for a type with `sincos_pair` (nhdyn::interval) that; otherwise
 /// the scalar's own sin and cos.
 template <class T>
 inline sin_cos<T> sincos_of(const T& x) {
   if constexpr (std::is_same_v<T, double>) {
     if (std::abs(x) <= 1e5) return sincos_kernel(x);
+  } else if constexpr (requires { sincos_pair(x); }) {  // e.g. nhdyn::interval: both at once
+    auto p = sincos_pair(x);
+    return {std::move(p.first), std::move(p.second)};
+  } else if constexpr (double_dual<T>) {
+    // One sin/cos of the value; the derivative parts by the chain rule.
+    const auto p = sincos_of(x.value());
+    return {chain_rule(x, p.s, p.c), chain_rule(x, p.c, -p.s)};
   }
   using std::cos;
   using std::sin;
@@ -218,9 +201,16 @@ void joint_angles(const Links& L, const Q& q, int n, T* c, T* s) {
     }
   }
   for (int i = 0; i < n; ++i) {
-    const T t = theta(i);
-    c[i] = cos(t);
-    s[i] = sin(t);
+    const auto& k = L[static_cast<std::size_t>(i)];
+    if (k.revolute) {
+      const auto p = sincos_of(T(q(i) + k.th0));
+      c[i] = p.c;
+      s[i] = p.s;
+    } else {  // a constant angle: sin/cos in the model's scalar
+      const auto p = sincos_of(k.th0);
+      c[i] = T(p.c);
+      s[i] = T(p.s);
+    }
   }
   correct_angle_sums(L, q, n, c, s);
 }
@@ -252,7 +242,7 @@ struct v3 {
   T x, y, z;
 };
 template <class T>
-inline v3<T> operator+(const v3<T>& a, const v3<T>& b) {
+[[gnu::always_inline]] inline v3<T> operator+(const v3<T>& a, const v3<T>& b) {
   return {a.x + b.x, a.y + b.y, a.z + b.z};
 }
 template <class T>
@@ -260,26 +250,51 @@ inline v3<T> operator*(const std::type_identity_t<T>& s, const v3<T>& a) {  // T
   return {s * a.x, s * a.y, s * a.z};
 }
 template <class T>
-inline v3<T> cross(const v3<T>& a, const v3<T>& b) {
+[[gnu::always_inline]] inline v3<T> cross(const v3<T>& a, const v3<T>& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-/// Rᵀ v (frame i−1 → frame i) with R = Rz(θ) Rx(α).
-template <class T>
-inline v3<T> rot_T(const T& ca, const T& sa, const T& ct, const T& st, const v3<T>& v) {
+// Mixed forms: a model constant (scalar C, e.g. double) with a state-dependent vector
+// (scalar T, e.g. a dual or an interval). The constant is not promoted to T, so a dual
+// pays K + 1 operations for the product, not 2K + 1 (scalar/dual.hpp), and an interval
+// two products, not four. For T = C they are the plain forms.
+/// s v for a constant s.
+template <class C, class T>
+[[gnu::always_inline]] inline v3<T> scale(const C& s, const v3<T>& a) {
+  return {T(s * a.x), T(s * a.y), T(s * a.z)};
+}
+/// a × c for a constant c.
+template <class T, class C>
+[[gnu::always_inline]] inline v3<T> cross_c(const v3<T>& a, const v3<C>& c) {
+  return {T(a.y * c.z - a.z * c.y), T(a.z * c.x - a.x * c.z), T(a.x * c.y - a.y * c.x)};
+}
+/// c × a for a constant c.
+template <class C, class T>
+[[gnu::always_inline]] inline v3<T> c_cross(const v3<C>& c, const v3<T>& a) {
+  return {T(c.y * a.z - c.z * a.y), T(c.z * a.x - c.x * a.z), T(c.x * a.y - c.y * a.x)};
+}
+/// Rᵀ v (frame i−1 → frame i) with R = Rz(θ) Rx(α); cos α, sin α constants (and cos θ,
+/// sin θ too for a prismatic joint: A = C).
+template <class C, class A, class T>
+[[gnu::always_inline]] inline v3<T> rot_T(const C& ca, const C& sa, const A& ct, const A& st, const v3<T>& v) {
   const T uy = ct * v.y - st * v.x;
-  return {ct * v.x + st * v.y, ca * uy + sa * v.z, ca * v.z - sa * uy};
+  return {T(ct * v.x + st * v.y), T(ca * uy + sa * v.z), T(ca * v.z - sa * uy)};
 }
 /// R v (frame i → frame i−1).
-template <class T>
-inline v3<T> rot(const T& ca, const T& sa, const T& ct, const T& st, const v3<T>& v) {
+template <class C, class A, class T>
+[[gnu::always_inline]] inline v3<T> rot(const C& ca, const C& sa, const A& ct, const A& st, const v3<T>& v) {
   const T uy = ca * v.y - sa * v.z;
-  return {ct * v.x - st * uy, st * v.x + ct * uy, sa * v.y + ca * v.z};
+  return {T(ct * v.x - st * uy), T(st * v.x + ct * uy), T(sa * v.y + ca * v.z)};
 }
-/// I v for a symmetric I given as (xx, yy, zz, xy, xz, yz).
+/// A constant vector in the computation's scalar.
+template <class T, class C>
+inline v3<T> z_as(const v3<C>& c) {
+  return {T(c.x), T(c.y), T(c.z)};
+}
+/// I v for a constant symmetric I given as (xx, yy, zz, xy, xz, yz).
 template <class T, class S>
-inline v3<T> sym_times(const S* I, const v3<T>& v) {
-  return {T(I[0]) * v.x + T(I[3]) * v.y + T(I[4]) * v.z, T(I[3]) * v.x + T(I[1]) * v.y + T(I[5]) * v.z,
-          T(I[4]) * v.x + T(I[5]) * v.y + T(I[2]) * v.z};
+[[gnu::always_inline]] inline v3<T> sym_times(const S* I, const v3<T>& v) {
+  return {T(I[0] * v.x + I[3] * v.y + I[4] * v.z), T(I[3] * v.x + I[1] * v.y + I[5] * v.z),
+          T(I[4] * v.x + I[5] * v.y + I[2] * v.z)};
 }
 
 /// z_{i−1} in frame i.

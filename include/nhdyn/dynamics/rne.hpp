@@ -36,8 +36,10 @@ struct rne_scratch {
 /// The recursion. Gravity and Velocity are compile-time so that a call that needs
 /// neither pays for neither. Written on plain scalars (detail::v3): this is the hot loop
 /// of the library, and the benchmark (docs/performance.md) chose this form.
+/// The n results go to `tau` (already of size n). `tau` may be the storage of `qdd`: q̈_i is
+/// read only in the forward pass, τ_i written only in the backward pass.
 template <bool Gravity, bool Velocity, class T, int N, class Links, class Q, class QD, class QDD>
-vecN<T, N> rne_kernel(const Links& L, const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd) {
+void rne_kernel(const Links& L, const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd, vecN<T, N>& tau) {
   const int n = static_cast<int>(q.size());
   small_buffer<rne_scratch<T>, N> ws(n);
   small_buffer<T, N> cs(n), sn(n);  // cos θ_i, sin θ_i
@@ -45,48 +47,82 @@ vecN<T, N> rne_kernel(const Links& L, const vec3<T>& g, const Q& q, const QD& qd
   const T zero(0);
   v3<T> w{zero, zero, zero}, dw{zero, zero, zero};  // ω_i, ω̇_i  (frame i)
   v3<T> acc = Gravity ? v3<T>{-g.x(), -g.y(), -g.z()} : v3<T>{zero, zero, zero};  // a_{o_i} − g
-  // Forward pass: velocities and accelerations, base to tip.
-  for (int i = 0; i < n; ++i) {
+  // Forward pass: velocities and accelerations, base to tip. Model constants (cos α, sin α,
+  // m, m c, I_o, and p for a revolute joint) stay in the model's scalar: mixed products
+  // (detail/dh.hpp) are cheaper for duals and intervals, and the same for double.
+  //
+  // Links before the first revolute joint (a mobile base's x and y, say) only translate:
+  // ω = ω̇ = 0 there, so a_i = R_iᵀ a_{i−1} + z q̈_i and every cross product vanishes. They
+  // get that short form (the same numbers; for a dual it saves most of the work of those
+  // links), and the backward pass skips their moments, which no τ reads.
+  int prefix = 0;
+  while (prefix < n && !L[static_cast<std::size_t>(prefix)].revolute) ++prefix;
+  for (int i = 0; i < prefix; ++i) {
     const auto& k = L[static_cast<std::size_t>(i)];
-    const T ca(k.ca), sa(k.sa);
-    const T ct = cs[i], st = sn[i];
     const T qddi(qdd(i));
-    const T d = k.revolute ? T(k.d0) : T(T(k.d0) + T(q(i)));
-    const v3<T> p = k.revolute ? v3<T>{T(k.p0[0]), T(k.p0[1]), T(k.p0[2])} : v3<T>{T(k.a), d * sa, d * ca};
+    acc = rot_T(k.ca, k.sa, k.ct0, k.st0, acc);
+    acc = v3<T>{acc.x, T(acc.y + qddi * k.sa), T(acc.z + qddi * k.ca)};  // + z q̈_i, z = (0, sin α, cos α)
+    auto& s = ws[i];
+    if (k.has_inertia) {
+      const v3<std::remove_cvref_t<decltype(k.ca)>> h{k.hs[0], k.hs[1], k.hs[2]};
+      s.F = scale(k.m, acc);
+      s.Nn = c_cross(h, acc);
+    } else {
+      s.F = v3<T>{zero, zero, zero};
+      s.Nn = s.F;
+    }
+  }
+  for (int i = prefix; i < n; ++i) {
+    const auto& k = L[static_cast<std::size_t>(i)];
+    const auto& ca = k.ca;
+    const auto& sa = k.sa;
+    const T qddi(qdd(i));
     if (k.revolute) {
+      const T ct = cs[i], st = sn[i];
+      const v3<std::remove_cvref_t<decltype(ca)>> p{k.p0[0], k.p0[1], k.p0[2]};
       // ω_i = Rᵀ(ω_{i−1} + z q̇_i), ω̇_i = Rᵀ(ω̇_{i−1} + z q̈_i + ω_{i−1} × z q̇_i)
       if constexpr (Velocity) {
         const T qdi(qd(i));
-        dw = rot_T(ca, sa, ct, st, v3<T>{dw.x + w.y * qdi, dw.y - w.x * qdi, dw.z + qddi});
-        w = rot_T(ca, sa, ct, st, v3<T>{w.x, w.y, w.z + qdi});
-        acc = rot_T(ca, sa, ct, st, acc) + cross(dw, p) + cross(w, cross(w, p));
+        dw = rot_T(ca, sa, ct, st, v3<T>{T(dw.x + w.y * qdi), T(dw.y - w.x * qdi), T(dw.z + qddi)});
+        w = rot_T(ca, sa, ct, st, v3<T>{w.x, w.y, T(w.z + qdi)});
+        acc = rot_T(ca, sa, ct, st, acc) + cross_c(dw, p) + cross(w, cross_c(w, p));
       } else {
-        dw = rot_T(ca, sa, ct, st, v3<T>{dw.x, dw.y, dw.z + qddi});
-        acc = rot_T(ca, sa, ct, st, acc) + cross(dw, p);
+        dw = rot_T(ca, sa, ct, st, v3<T>{dw.x, dw.y, T(dw.z + qddi)});
+        acc = rot_T(ca, sa, ct, st, acc) + cross_c(dw, p);
       }
     } else {
-      // a_i gains z q̈_i (and 2 ω_i × z q̇_i) for a prismatic joint.
-      const v3<T> z{zero, sa, ca};
-      if constexpr (Velocity) {
-        w = rot_T(ca, sa, ct, st, w);
-        dw = rot_T(ca, sa, ct, st, dw);
-        acc = rot_T(ca, sa, ct, st, acc) + qddi * z + cross(dw, p) + cross(w, cross(w, p)) +
-              (T(2) * T(qd(i))) * cross(w, z);
-      } else {
-        dw = rot_T(ca, sa, ct, st, dw);
-        acc = rot_T(ca, sa, ct, st, acc) + qddi * z + cross(dw, p);
-      }
+      // a_i gains z q̈_i (and 2 ω_i × z q̇_i) for a prismatic joint. θ is constant: for a
+      // floating-point T its cos/sin come from the link constants (measured faster); for
+      // duals from the batch above (the mixed forms made the dual kernel slower there).
+      const auto prismatic = [&](const auto ct, const auto st) __attribute__((always_inline)) {  // by value: no aliasing with w, ω̇, a
+        const T d(k.d0 + q(i));
+        const v3<T> p{T(k.a), T(d * sa), T(d * ca)};
+        const v3<std::remove_cvref_t<decltype(ca)>> z{decltype(ca)(0), sa, ca};
+        if constexpr (Velocity) {
+          w = rot_T(ca, sa, ct, st, w);
+          dw = rot_T(ca, sa, ct, st, dw);
+          acc = rot_T(ca, sa, ct, st, acc) + scale(qddi, z_as<T>(z)) + cross(dw, p) + cross(w, cross(w, p)) +
+                scale(T(T(2) * T(qd(i))), cross_c(w, z));
+        } else {
+          dw = rot_T(ca, sa, ct, st, dw);
+          acc = rot_T(ca, sa, ct, st, acc) + scale(qddi, z_as<T>(z)) + cross(dw, p);
+        }
+      };
+      if constexpr (std::is_floating_point_v<T>)
+        prismatic(k.ct0, k.st0);
+      else
+        prismatic(cs[i], sn[i]);
     }
     auto& s = ws[i];
-    if (k.inert) {
-      const v3<T> h{T(k.hs[0]), T(k.hs[1]), T(k.hs[2])};
+    if (k.has_inertia) {
+      const v3<std::remove_cvref_t<decltype(ca)>> h{k.hs[0], k.hs[1], k.hs[2]};
       // F_i = m a_{c_i} = m a_i + ω̇×h + ω×(ω×h);  N_i = I_o ω̇ + ω×(I_o ω) + h×a_i
       if constexpr (Velocity) {
-        s.F = T(k.m) * acc + cross(dw, h) + cross(w, cross(w, h));
-        s.Nn = sym_times<T>(k.Is, dw) + cross(w, sym_times<T>(k.Is, w)) + cross(h, acc);
+        s.F = scale(k.m, acc) + cross_c(dw, h) + cross(w, cross_c(w, h));
+        s.Nn = sym_times<T>(k.Is, dw) + cross(w, sym_times<T>(k.Is, w)) + c_cross(h, acc);
       } else {
-        s.F = T(k.m) * acc + cross(dw, h);
-        s.Nn = sym_times<T>(k.Is, dw) + cross(h, acc);
+        s.F = scale(k.m, acc) + cross_c(dw, h);
+        s.Nn = sym_times<T>(k.Is, dw) + c_cross(h, acc);
       }
     } else {
       s.F = v3<T>{zero, zero, zero};
@@ -94,29 +130,47 @@ vecN<T, N> rne_kernel(const Links& L, const vec3<T>& g, const Q& q, const QD& qd
     }
   }
   // Backward pass: f_i = R_{i+1} f_{i+1} + F_i, n_i = R_{i+1} n_{i+1} + p_i × f_i + N_i.
-  vecN<T, N> tau(n);
   v3<T> f{zero, zero, zero}, m{zero, zero, zero};
-  for (int i = n - 1; i >= 0; --i) {
+  for (int i = n - 1; i >= prefix; --i) {
     const auto& k = L[static_cast<std::size_t>(i)];
-    const T ca(k.ca), sa(k.sa);
+    const auto& ca = k.ca;
+    const auto& sa = k.sa;
     const auto& s = ws[i];
     if (i + 1 < n) {
       const auto& k1 = L[static_cast<std::size_t>(i + 1)];
-      const T ca1(k1.ca), sa1(k1.sa), ct1 = cs[i + 1], st1 = sn[i + 1];
-      f = rot(ca1, sa1, ct1, st1, f);
-      m = rot(ca1, sa1, ct1, st1, m);
+      if (k1.revolute) {
+        const T ct1 = cs[i + 1], st1 = sn[i + 1];
+        f = rot(k1.ca, k1.sa, ct1, st1, f);
+        m = rot(k1.ca, k1.sa, ct1, st1, m);
+      } else {
+        f = rot(k1.ca, k1.sa, k1.ct0, k1.st0, f);
+        m = rot(k1.ca, k1.sa, k1.ct0, k1.st0, m);
+      }
     }
     f = f + s.F;
     if (k.revolute) {
-      m = m + cross(v3<T>{T(k.p0[0]), T(k.p0[1]), T(k.p0[2])}, f) + s.Nn;
+      const v3<std::remove_cvref_t<decltype(ca)>> p{k.p0[0], k.p0[1], k.p0[2]};
+      m = m + c_cross(p, f) + s.Nn;
       tau(i) = sa * m.y + ca * m.z;  // z_{i−1} · n_i
     } else {
-      const T d = T(k.d0) + T(q(i));
-      m = m + cross(v3<T>{T(k.a), d * sa, d * ca}, f) + s.Nn;
+      const T d(k.d0 + q(i));
+      m = m + cross(v3<T>{T(k.a), T(d * sa), T(d * ca)}, f) + s.Nn;
       tau(i) = sa * f.y + ca * f.z;  // z_{i−1} · f_i
     }
   }
-  return tau;
+  // The translating prefix: forces only (τ_i = z_{i−1} · f_i; their moments are not needed).
+  for (int i = prefix - 1; i >= 0; --i) {
+    const auto& k = L[static_cast<std::size_t>(i)];
+    if (i + 1 < n) {  // (a chain of prismatic joints only: its last link has no successor)
+      const auto& k1 = L[static_cast<std::size_t>(i + 1)];
+      if (k1.revolute)
+        f = rot(k1.ca, k1.sa, cs[i + 1], sn[i + 1], f);
+      else
+        f = rot(k1.ca, k1.sa, k1.ct0, k1.st0, f);
+    }
+    f = f + ws[i].F;
+    tau(i) = k.sa * f.y + k.ca * f.z;
+  }
 }
 
 /// Throws a clear error when a result is not finite: names the non-finite input, or says
@@ -167,15 +221,8 @@ class rne_fn : public stage_tag {
     detail::check_size(q, n_, "q");
     detail::check_size(qd, n_, "qd");
     detail::check_size(qdd, n_, "qdd");
-    const vec3<T> g = g_.template cast<T>();
-    vecN<T, N> v;
-    if (opt_.gravity) {
-      v = opt_.velocity ? detail::rne_kernel<true, true, T, N>(links_, g, q, qd, qdd)
-                        : detail::rne_kernel<true, false, T, N>(links_, g, q, qd, qdd);
-    } else {
-      v = opt_.velocity ? detail::rne_kernel<false, true, T, N>(links_, g, q, qd, qdd)
-                        : detail::rne_kernel<false, false, T, N>(links_, g, q, qd, qdd);
-    }
+    vecN<T, N> v(n_);
+    run(q, qd, qdd, v);
     detail::check_result(v, q, qd, qdd, "rne");
     return v;
   }
@@ -185,12 +232,23 @@ class rne_fn : public stage_tag {
   generalized_forces<promote_t<S, X>, N> operator()(const joint_state<X, N>& xi) const {
     return {xi.q.template cast<promote_t<S, X>>(), (*this)(xi.q, xi.qd, xi.qdd)};
   }
-  /// Pipeline form on a temporary ξ: q moves on instead of being copied.
+  /// Pipeline form on a temporary ξ: q moves on, and v is written over q̈'s storage (q̈_i is
+  /// read before v_i is written), so the stage allocates nothing.
   template <class X>
   generalized_forces<promote_t<S, X>, N> operator()(joint_state<X, N>&& xi) const {
     if constexpr (std::is_same_v<promote_t<S, X>, X>) {
-      vecN<X, N> v = (*this)(xi.q, xi.qd, xi.qdd);
-      return {std::move(xi.q), std::move(v)};
+      run_in_place(xi);
+      return {std::move(xi.q), std::move(xi.qdd)};
+    } else {
+      return (*this)(static_cast<const joint_state<X, N>&>(xi));
+    }
+  }
+  /// …and with a memo, which travels on with (q, v).
+  template <class X, class Memo>
+  auto operator()(with_memo<joint_state<X, N>, Memo>&& xi) const {
+    if constexpr (std::is_same_v<promote_t<S, X>, X>) {
+      run_in_place(xi);
+      return with_memo<generalized_forces<X, N>, Memo>{{std::move(xi.q), std::move(xi.qdd)}, std::move(xi.memo)};
     } else {
       return (*this)(static_cast<const joint_state<X, N>&>(xi));
     }
@@ -206,6 +264,36 @@ class rne_fn : public stage_tag {
   const typename detail::dh_links<S, N>::type& links() const { return links_; }
 
  private:
+  /// v over ξ.qdd.
+  template <class X>
+  void run_in_place(joint_state<X, N>& xi) const {
+    detail::check_size(xi.q, n_, "q");
+    detail::check_size(xi.qd, n_, "qd");
+    detail::check_size(xi.qdd, n_, "qdd");
+    run(xi.q, xi.qd, xi.qdd, xi.qdd);
+    // q̈ is gone (v is in its place), so a non-finite result names q or q̇ when they are the
+    // cause, and otherwise says "q̈ or overflow". Not checking q̈ before is measurable (4 ns
+    // of a 115 ns paper5 call); inside inverse_dynamics, lift has checked η̇ already.
+    for (Eigen::Index i = 0; i < xi.qdd.size(); ++i)
+      if (!is_finite_scalar(xi.qdd(i))) [[unlikely]] {
+        detail::check_finite(xi.q, "q");
+        detail::check_finite(xi.qd, "qd");
+        throw numerical_error("rne: result " + std::to_string(i) +
+                              " is not finite: qdd has a non-finite entry, or the computation overflowed");
+      }
+  }
+  template <class Q, class QD, class QDD, class T>
+  void run(const Q& q, const QD& qd, const QDD& qdd, vecN<T, N>& v) const {
+    const vec3<T> g = g_.template cast<T>();
+    if (opt_.gravity) {
+      opt_.velocity ? detail::rne_kernel<true, true, T, N>(links_, g, q, qd, qdd, v)
+                    : detail::rne_kernel<true, false, T, N>(links_, g, q, qd, qdd, v);
+    } else {
+      opt_.velocity ? detail::rne_kernel<false, true, T, N>(links_, g, q, qd, qdd, v)
+                    : detail::rne_kernel<false, false, T, N>(links_, g, q, qd, qdd, v);
+    }
+  }
+
   typename detail::dh_links<S, N>::type links_;
   vec3<S> g_;
   int n_;
