@@ -220,3 +220,38 @@ TEST_CASE("linearize: jacobian of a user pipeline with a user stage, and bad siz
   CHECK_THROWS_WITH(nhdyn::linearize_inverse_dynamics(r.chain, r.constraint, q0, bad, etad0),
                     Catch::Contains("eta has 3 entries"));
 }
+
+TEST_CASE("linearize: the linearizer skips only columns that vanish, and the rest equal full seeding") {
+  const auto r = nhdyn::presets::paper5();
+  const nhdyn::inverse_dynamics_linearizer lin(r.chain, r.constraint);
+  // paper5: q₁, q₂ (the base's x and y, prismatic, before every revolute joint, not the heading).
+  REQUIRE(lin.computed_columns().size() == 11u);
+  CHECK(lin.computed_columns().front() == 2);
+  V13 z;
+  z << q0, eta0, etad0;
+  const auto id = nhdyn::inverse_dynamics(r.chain, r.constraint);
+  const auto f = [&](const auto& x) { return id(x.template head<5>(), x.template segment<4>(5), x.template tail<4>()); };
+  for (double s : {1.0, -0.3, 2.5}) {
+    const V13 zs = s * z;
+    const auto full = nhdyn::jacobian(f, zs);  // every column seeded (dual<double, 13>)
+    const auto J = lin(zs.head<5>(), zs.segment<4>(5), zs.tail<4>()).J;
+    // Columns 1–2 vanish in the full computation too: exactly, not just to rounding.
+    CHECK(full.leftCols(2).cwiseAbs().maxCoeff() == 0.0);
+    // Each derivative lane is computed by the same operations: the same numbers.
+    CHECK((J - full).cwiseAbs().maxCoeff() == 0.0);
+  }
+  // A user constraint may depend on any joint: nothing skipped. The same S as paper5's.
+  const auto c = r.constraint;
+  const auto user = nhdyn::make_constraint(
+      5, 1, [c](const auto& q) { return c.A(q); }, [c](const auto& q) { return c.S(q); });
+  const nhdyn::inverse_dynamics_linearizer lu(r.chain.dynamic_size(), user);
+  CHECK(lu.computed_columns().size() == 13u);
+  const Eigen::VectorXd qd = q0, ed = eta0, edd = etad0;
+  CHECK(rel_err(lu(qd, ed, edd).J, lin(q0, eta0, etad0).J) < 1e-13);
+  // A revolute joint first: a translation after it is not a symmetry; nothing skipped.
+  auto links = std::vector<nhdyn::link<double>>(r.chain.begin(), r.chain.end());
+  std::swap(links[0], links[2]);
+  const nhdyn::chain<double> turned(links, r.chain.gravity(), "turned");
+  const nhdyn::differential_drive<double> dd(5, 1, 2, 0, 0.0, -1.0);
+  CHECK(nhdyn::inverse_dynamics_linearizer(turned, dd).computed_columns().size() == 13u);
+}

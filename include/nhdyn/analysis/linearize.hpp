@@ -8,7 +8,8 @@
 /// - `central_difference_jacobian(f, x, h)`: the same by central differences (2 evaluations
 ///   per column, error O(h²) + O(ε/h)), for checks and comparisons.
 /// - `linearize_inverse_dynamics(chain, c, q, η, η̇)`: ∂τ/∂ζ of τ = project∘rne∘lift, with
-///   ζ = (q, η, η̇) and the blocks ∂τ/∂q, ∂τ/∂η, ∂τ/∂η̇ (= M_η when E = S).
+///   ζ = (q, η, η̇) and the blocks ∂τ/∂q, ∂τ/∂η, ∂τ/∂η̇ (= M_η when E = S);
+///   `inverse_dynamics_linearizer(chain, c)` is the same as a function object built once.
 /// - `linearize_forward_dynamics(chain, c, q, η, τ)`: ẋ = f(x, u) with x = (q, η),
 ///   f = (S(q)η, η̇(q, η, τ)), u = τ → A = ∂f/∂x, B = ∂f/∂u. For a holonomic chain,
 ///   `linearize_forward_dynamics(chain, q, q̇, τ)`: x = (q, q̇), f = (q̇, q̈).
@@ -23,6 +24,7 @@
 ///   I_zz,i) for every link i (columns link by link).
 #include <Eigen/Core>
 #include <type_traits>
+#include <vector>
 
 #include "../constraints/constraint.hpp"
 #include "../constraints/forward_dynamics.hpp"
@@ -41,29 +43,42 @@ template <class Y>
 using eigen_vector_of = std::remove_cvref_t<Y>;
 }  // namespace detail
 
+namespace detail {
+/// Columns `cols` of ∂f/∂x by duals of K components (⌈|cols|/K⌉ passes); every other
+/// column is left zero — for columns known to vanish identically.
+template <int K, class F, class X>
+auto jacobian_columns(const F& f, const Eigen::MatrixBase<X>& x, const int* cols, int ncols) {
+  using T = typename X::Scalar;
+  constexpr int Nx = X::SizeAtCompileTime;
+  using D = dual<T, K>;
+  using Y = eigen_vector_of<decltype(f(std::declval<const vecN<D, Nx>&>()))>;
+  constexpr int Ny = Y::SizeAtCompileTime;
+  const int n = static_cast<int>(x.size());
+  Eigen::Matrix<T, Ny, Nx> J;
+  vecN<D, Nx> xd(n);
+  for (int c0 = 0; c0 < std::max(ncols, 1); c0 += K) {
+    for (int i = 0; i < n; ++i) xd(i) = D(T(x(i)));
+    for (int k = 0; k < K && c0 + k < ncols; ++k) xd(cols[c0 + k]).derivative(k) = T(1);
+    const Y y = f(xd);
+    if (c0 == 0) J.setZero(y.size(), n);
+    for (Eigen::Index r = 0; r < y.size(); ++r) {
+      const D& yr = y(r);  // no copy when f returns duals (the usual case)
+      for (int k = 0; k < K && c0 + k < ncols; ++k) J(r, cols[c0 + k]) = yr.derivative(k);
+    }
+  }
+  return J;
+}
+}  // namespace detail
+
 /// ∂f/∂x at x (rows: f's entries, columns: x's), exact to rounding, by duals. f takes an
 /// Eigen vector of duals (same size as x) and returns an Eigen vector whose scalar is a dual
 /// (or anything Eigen converts to one); write f generic (auto parameters).
 template <class F, class X>
 auto jacobian(const F& f, const Eigen::MatrixBase<X>& x) {
-  using T = typename X::Scalar;
-  constexpr int Nx = X::SizeAtCompileTime;
-  constexpr int K = detail::seed_chunk<Nx>;
-  using D = dual<T, K>;
-  using Y = detail::eigen_vector_of<decltype(f(std::declval<const vecN<D, Nx>&>()))>;
-  constexpr int Ny = Y::SizeAtCompileTime;
   const int n = static_cast<int>(x.size());
-  Eigen::Matrix<T, Ny, Nx> J;
-  vecN<D, Nx> xd(n);
-  for (int c0 = 0; c0 < n; c0 += K) {
-    for (int i = 0; i < n; ++i) xd(i) = D(T(x(i)));
-    for (int k = 0; k < K && c0 + k < n; ++k) xd(c0 + k).derivative(k) = T(1);
-    const Y y = f(xd);
-    if (c0 == 0) J.resize(y.size(), n);
-    for (Eigen::Index r = 0; r < y.size(); ++r)
-      for (int k = 0; k < K && c0 + k < n; ++k) J(r, c0 + k) = D(y(r)).derivative(k);
-  }
-  return J;
+  std::vector<int> cols(static_cast<std::size_t>(n));
+  for (int j = 0; j < n; ++j) cols[static_cast<std::size_t>(j)] = j;
+  return detail::jacobian_columns<detail::seed_chunk<X::SizeAtCompileTime>>(f, x, cols.data(), n);
 }
 
 /// ∂f/∂x by central differences (f(x + h e_j) − f(x − h e_j)) / 2h, step h·max(1, |x_j|).
@@ -114,27 +129,84 @@ auto stack3(const A& a, const B& b, const C& c) {
 }
 }  // namespace detail
 
-/// ∂τ/∂(q, η, η̇) at (q, η, η̇), by duals through project∘rne∘lift.
+/// ∂τ/∂(q, η, η̇) as a function object: the pipeline project∘rne∘lift is built once (as
+/// `inverse_dynamics` is), and every call evaluates it once on duals seeded along all of
+/// ζ = (q, η, η̇) (compile-time sizes ≤ 16: one pass).
+///
+///     const nhdyn::inverse_dynamics_linearizer lin(chain, constraint);
+///     auto J = lin(q, eta, eta_dot);   // J.J (m × (n + 2m)), J.dq(), J.deta(), J.deta_dot()
+///
+/// Columns known to vanish are not computed: ∂τ/∂q_j = 0 for a prismatic joint j that comes
+/// before every revolute joint (it translates everything after it, and the dynamics does
+/// not change under a translation) when the constraint does not depend on q_j
+/// (`differential_drive` depends on its heading joint only; `holonomic` on none; a user
+/// constraint on all). A planar base's x and y are such joints: for paper5, 11 of the 13
+/// columns are seeded. The skipped columns are exact zeros, and the rest are the same
+/// numbers as with every column seeded (tests/test_linearize.cpp checks both).
+template <class S, int N, class C>
+class inverse_dynamics_linearizer {
+ public:
+  inverse_dynamics_linearizer(const chain<S, N>& ch, const C& c, rne_options o = {})
+      : id_(inverse_dynamics(ch, c, o)), n_(c.dof()), m_(c.m()) {
+    const int z = n_ + 2 * m_;
+    bool before_revolute = true;
+    for (int j = 0; j < z; ++j) {
+      if (j < n_) before_revolute = before_revolute && ch[j].joint == joint_type::prismatic;
+      const bool zero = j < n_ && before_revolute && !constraint_depends_on(c, j);
+      if (!zero) cols_.push_back(j);
+    }
+  }
+
+  /// The columns of ∂τ/∂ζ that are computed (the others are structurally zero).
+  const std::vector<int>& computed_columns() const { return cols_; }
+
+  template <class Q, class E, class ED>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
+                  const Eigen::MatrixBase<ED>& eta_dot) const {
+    constexpr int M = C::m_at_compile_time;
+    constexpr int Z = detail::stacked<N, M>;
+    if constexpr (N == dynamic) detail::check_size(q, n_, "q");
+    detail::check_size(eta, m_, "eta");
+    detail::check_size(eta_dot, m_, "eta_dot");
+    const int n = n_, m = m_;
+    const auto f = [&](const auto& z) {
+      if constexpr (Z != dynamic)
+        return id_(z.template head<N>(), z.template segment<M>(N), z.template tail<M>());
+      else
+        return id_(z.head(n), z.segment(n, m), z.tail(m));
+    };
+    using T = typename Q::Scalar;
+    inverse_dynamics_jacobian<T, N, M> out;
+    out.n = n;
+    out.m = m;
+    const auto z = detail::stack3<Z>(q.template cast<T>(), eta, eta_dot);
+    const int nc = static_cast<int>(cols_.size());
+    constexpr int K = detail::seed_chunk<Z>;
+    // A fixed-size ζ with exactly two vanishing columns (a planar base's x and y) gets its
+    // own, narrower dual; any other count seeds K at a time.
+    if constexpr (Z != dynamic && K > 2) {
+      if (nc == Z - 2) {
+        out.J = detail::jacobian_columns<K - 2>(f, z, cols_.data(), nc);
+        return out;
+      }
+    }
+    out.J = detail::jacobian_columns<K>(f, z, cols_.data(), nc);
+    return out;
+  }
+
+ private:
+  decltype(inverse_dynamics(std::declval<const chain<S, N>&>(), std::declval<const C&>())) id_;
+  int n_, m_;
+  std::vector<int> cols_;
+};
+
+/// ∂τ/∂(q, η, η̇) at (q, η, η̇), by duals through project∘rne∘lift (builds the pipeline for
+/// this one call; keep an inverse_dynamics_linearizer to evaluate many states).
 template <class S, int N, class C, class Q, class E, class ED>
 auto linearize_inverse_dynamics(const chain<S, N>& ch, const C& c, const Eigen::MatrixBase<Q>& q,
                                 const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
                                 rne_options o = {}) {
-  constexpr int M = C::m_at_compile_time;
-  constexpr int Z = detail::stacked<N, M>;
-  const int n = c.dof(), m = c.m();
-  if constexpr (N == dynamic) detail::check_size(q, n, "q");
-  detail::check_size(eta, m, "eta");
-  detail::check_size(eta_dot, m, "eta_dot");
-  const auto id = inverse_dynamics(ch, c, o);
-  const auto f = [&](const auto& z) {
-    return id(z.head(n), z.segment(n, m), z.tail(m));
-  };
-  using T = typename Q::Scalar;
-  inverse_dynamics_jacobian<T, N, M> out;
-  out.n = n;
-  out.m = m;
-  out.J = jacobian(f, detail::stack3<Z>(q.template cast<T>(), eta, eta_dot));
-  return out;
+  return inverse_dynamics_linearizer<S, N, C>(ch, c, o)(q, eta, eta_dot);
 }
 
 /// ẋ = f(x, u) linearised: A = ∂f/∂x, B = ∂f/∂u.

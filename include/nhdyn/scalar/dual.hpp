@@ -10,6 +10,8 @@
 ///     D y = sin(x) * x;                 // y.value(), y.derivative(0) = cos(.3)·.3 + sin(.3)
 #include <Eigen/Core>
 #include <array>
+#include <bit>
+#include <cstdint>
 #include <cmath>
 #include <ostream>
 
@@ -93,6 +95,59 @@ class dual {
     for (int k = 0; k < K; ++k) r.b_[k] = (x.b_[k] - r.a_ * y.b_[k]) * inv;
     return r;
   }
+  // Mixed operations with a constant c (anything convertible to T that is not this dual:
+  // a double model parameter, or the inner dual of a nested one). They cost K + 1
+  // operations, not 2K + 1: the constant has no derivative part.
+  template <class U>
+    requires(!std::is_same_v<U, dual> && std::is_convertible_v<U, T>)
+  friend dual operator*(const dual& x, const U& c) {
+    dual r(uninitialized{});
+    const T cc(c);
+    r.a_ = x.a_ * cc;
+    for (int k = 0; k < K; ++k) r.b_[k] = x.b_[k] * cc;
+    return r;
+  }
+  template <class U>
+    requires(!std::is_same_v<U, dual> && std::is_convertible_v<U, T>)
+  friend dual operator*(const U& c, const dual& x) {
+    return x * c;
+  }
+  template <class U>
+    requires(!std::is_same_v<U, dual> && std::is_convertible_v<U, T>)
+  friend dual operator/(const dual& x, const U& c) {
+    dual r(uninitialized{});
+    const T inv = T(1) / T(c);
+    r.a_ = x.a_ * inv;
+    for (int k = 0; k < K; ++k) r.b_[k] = x.b_[k] * inv;
+    return r;
+  }
+  template <class U>
+    requires(!std::is_same_v<U, dual> && std::is_convertible_v<U, T>)
+  friend dual operator+(const dual& x, const U& c) {
+    dual r = x;
+    r.a_ += T(c);
+    return r;
+  }
+  template <class U>
+    requires(!std::is_same_v<U, dual> && std::is_convertible_v<U, T>)
+  friend dual operator+(const U& c, const dual& x) {
+    return x + c;
+  }
+  template <class U>
+    requires(!std::is_same_v<U, dual> && std::is_convertible_v<U, T>)
+  friend dual operator-(const dual& x, const U& c) {
+    dual r = x;
+    r.a_ -= T(c);
+    return r;
+  }
+  template <class U>
+    requires(!std::is_same_v<U, dual> && std::is_convertible_v<U, T>)
+  friend dual operator-(const U& c, const dual& x) {
+    dual r(uninitialized{});
+    r.a_ = T(c) - x.a_;
+    for (int k = 0; k < K; ++k) r.b_[k] = -x.b_[k];
+    return r;
+  }
   friend dual operator-(dual x) {
     x.a_ = -x.a_;
     for (auto& d : x.b_) d = -d;
@@ -111,7 +166,7 @@ class dual {
 
   /// f(x) with f(a) = fa and f'(a) = dfa.
   friend dual chain_rule(const dual& x, const T& fa, const T& dfa) {
-    dual r;
+    dual r(uninitialized{});
     r.a_ = fa;
     for (int k = 0; k < K; ++k) r.b_[k] = dfa * x.b_[k];
     return r;
@@ -163,9 +218,18 @@ class dual {
     return chain_rule(x, pow(x.a_, T(p)), T(p) * pow(x.a_, T(p - 1)));
   }
   friend bool isfinite(const dual& x) {
-    bool ok = is_finite_scalar(x.a_);
-    for (const auto& d : x.b_) ok = ok && is_finite_scalar(d);
-    return ok;
+    if constexpr (std::is_same_v<T, double>) {
+      // An IEEE double is finite unless its exponent bits are all ones: one branch-free,
+      // vectorisable pass over the K + 1 numbers.
+      constexpr std::uint64_t e = 0x7ff0000000000000ULL;
+      bool bad = (std::bit_cast<std::uint64_t>(x.a_) & e) == e;
+      for (int k = 0; k < K; ++k) bad |= (std::bit_cast<std::uint64_t>(x.b_[k]) & e) == e;
+      return !bad;
+    } else {
+      bool ok = is_finite_scalar(x.a_);
+      for (const auto& d : x.b_) ok = ok && is_finite_scalar(d);
+      return ok;
+    }
   }
   friend std::ostream& operator<<(std::ostream& os, const dual& x) {
     os << x.a_ << " [";
