@@ -24,7 +24,7 @@ using ad_dyn = Eigen::AutoDiffScalar<Eigen::VectorXd>;
 using nhdyn::interval;
 
 template <class S>
-constexpr bool is_interval = std::is_same_v<S, interval>;
+constexpr bool is_interval = std::is_same_v<S, interval> || std::is_same_v<S, nhdyn::boost_interval>;
 
 /// Unit roundoff of S's arithmetic (of the value part for duals / autodiff).
 template <class S>
@@ -33,7 +33,7 @@ double eps() {
   else if constexpr (std::is_same_v<S, long double>) return 5.5e-20;
   else if constexpr (std::is_same_v<S, nhdyn::mp50> || std::is_same_v<S, nhdyn::dec50>) return 1e-49;
   else if constexpr (std::is_same_v<S, nhdyn::quad>) return 1e-34;
-  else if constexpr (std::is_same_v<S, interval>) return 1e-14;  // widths grow with |intermediates| (m·g ≈ 90 N ≫ τ): see test_bounds
+  else if constexpr (is_interval<S>) return 1e-14;  // widths grow with |intermediates| (m·g ≈ 90 N ≫ τ): see test_bounds
   else return 1.1e-16;  // double, duals and autodiff over double
 }
 
@@ -48,6 +48,7 @@ const char* name() {
   else if constexpr (std::is_same_v<S, dual2>) return "dual<double, 2>";
   else if constexpr (std::is_same_v<S, ad_fixed>) return "AutoDiffScalar<Vector2d>";
   else if constexpr (std::is_same_v<S, ad_dyn>) return "AutoDiffScalar<VectorXd>";
+  else if constexpr (std::is_same_v<S, nhdyn::boost_interval>) return "boost_interval";
   else return "interval";
 }
 
@@ -107,7 +108,7 @@ T energy(const Chain& ch, const nhdyn::vecN<T, 5>& q, const nhdyn::vecN<T, 5>& q
 
 #define NHDYN_SCALARS                                                                    \
   float, double, long double, nhdyn::mp50, nhdyn::dec50, nhdyn::quad, dual2, ad_fixed, ad_dyn, \
-      interval
+      interval, nhdyn::boost_interval
 
 TEMPLATE_TEST_CASE("scalars: rne equals M qdd + bias and the 50-digit rne, for every scalar", "[scalar]",
                    NHDYN_SCALARS) {

@@ -1,27 +1,37 @@
 #pragma once
 /// \file scalar/interval.hpp
-/// `nhdyn::interval`: Boost.Interval over double with outward rounding that does not depend
-/// on the floating-point rounding mode or on compiler flags, so every nhdyn algorithm gives a
-/// guaranteed enclosure of the exact result over a box of inputs.
+/// Interval arithmetic with outward rounding that does not depend on the floating-point
+/// rounding mode or on compiler flags, so every nhdyn algorithm gives a guaranteed enclosure
+/// of the exact result over a box of inputs. Two scalar types:
 ///
-/// Rounding policy (`outward_rounding`): each operation is computed in the default
-/// round-to-nearest mode, whose error is at most half an ulp (IEEE 754), and its result is
-/// then moved one ulp outward (down for a lower bound, up for an upper one). This is sound
-/// without `-frounding-math` and without switching the FPU mode (which compilers may reorder
-/// around). sin/cos/tan/exp/log/atan/sqrt use the C library (glibc: ≤ 1 ulp for these) and
-/// move 2 ulps outward; sin and cos are clamped to [−1, 1]. Range reduction of sin/cos is
-/// Boost's (by an enclosure of 2π).
+/// - `nhdyn::interval` — nhdyn's own, for speed: +, −, ×, ÷, sin and cos written here
+///   (branch-light, inlined), every other function (tan, exp, log, atan, sqrt, pow, the
+///   "certainly" comparisons, and sin/cos of wide arguments) through Boost.Interval.
+/// - `nhdyn::boost_interval` — Boost.Interval itself (`boost::numeric::interval` with the
+///   rounding policy below), every operation Boost's. The two give the same kind of
+///   guarantee; tests/test_scalar_types.cpp runs the typed identities over both, and
+///   tests/test_bounds.cpp checks that both enclose.
 ///
-/// Checking policy: `checking_base` — a NaN bound makes the interval empty, which nhdyn
-/// reports as "not finite". An unbounded enclosure (an infinite bound) is also "not finite":
-/// every algorithm's result check and the analysis/bounds.hpp functions say so by name.
+/// Rounding. Each operation is computed in the default round-to-nearest mode, whose error is
+/// at most half an ulp (IEEE 754), and its result is moved outward past the next double:
+/// `nhdyn::interval` by pred(x) = x − (φ|x| + η), succ(x) = x + (φ|x| + η) with
+/// φ = 2⁻⁵³(1 + 2⁻⁵²), η = 2⁻⁵⁰⁰ (Rump, Zimmermann, Boldo & Melquiond, "Computing
+/// predecessor and successor in rounding to nearest", BIT 49, 2009: the result is at least
+/// one ulp beyond x, with or without a fused multiply–add), `boost_interval` by stepping
+/// one ulp through the bit pattern. sin and cos of `nhdyn::interval`: on a piece where both
+/// are monotonic (|x| ≤ 1e5, the piece decided with a 1e-9 safety margin), the endpoint
+/// values of detail/dh.hpp's kernel (fdlibm's polynomials, error < 1 ulp ≤ 2.3e-16) widened
+/// by 4.5e-16 and then outward, clamped to [−1, 1]; otherwise Boost's. Library functions of
+/// `boost_interval` use the C library (glibc: ≤ 1 ulp) and move 2 ulps outward.
+///
+/// Empty and unbounded. An interval with a NaN bound is empty (Boost's `checking_base`); an
+/// infinite bound is unbounded. Both are "not finite": every algorithm's result check and
+/// the analysis/bounds.hpp functions say so by name. Division by an interval that contains
+/// 0 gives [−∞, +∞].
 ///
 /// nhdyn never compares intervals (Boost's `<` is "certainly less" and throws
 /// `interval_lib::comparison_error` when undecided, so a stray comparison shows up as an
 /// exception, not as a silently wrong branch); algorithms branch on `value_of(x)`, the midpoint.
-///
-/// `nhdyn::interval` wraps `boost::numeric::interval<double, policies<outward_rounding,
-/// checking_base>>` (see the class comment for why it wraps rather than aliases).
 ///
 ///     using I = nhdyn::interval;
 ///     I m = nhdyn::outward(0.9, 1.1);                  // a factor ±10 %, rounded outward
@@ -29,6 +39,9 @@
 #include <bit>
 #include <Eigen/Core>
 #include <boost/numeric/interval.hpp>
+#include <utility>
+
+#include "../detail/sincos.hpp"
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -114,67 +127,207 @@ struct outward_rounding {
 
 }  // namespace detail
 
-/// The Boost.Interval type nhdyn's interval is built on (outward rounding, checking_base).
-using boost_interval = boost::numeric::interval<
+/// The Boost.Interval type (outward rounding, checking_base) behind `boost_interval`.
+using boost_interval_base = boost::numeric::interval<
     double, boost::numeric::interval_lib::policies<detail::outward_rounding,
                                                    boost::numeric::interval_lib::checking_base<double>>>;
 
-/// A guaranteed enclosure [lo, hi] of a real number (see the file comment): a thin value
-/// wrapper around `boost_interval`. It exists because Boost's interval has an unconstrained
-/// converting constructor from any type, which makes Eigen take every matrix for a scalar
-/// (`Matrix * Matrix` becomes ambiguous); the wrapper converts only from double and from
-/// boost_interval, and forwards all arithmetic and functions to Boost.
-class interval {
+/// Boost.Interval as an nhdyn scalar: a thin value wrapper around `boost_interval_base`. It
+/// exists because Boost's interval has an unconstrained converting constructor from any
+/// type, which makes Eigen take every matrix for a scalar (`Matrix * Matrix` becomes
+/// ambiguous); the wrapper converts only from double and from boost_interval_base, and
+/// forwards all arithmetic and functions to Boost.
+class boost_interval {
  public:
-  interval() : x_(0.0) {}
-  interval(double v) : x_(v) {}  // NOLINT: a point interval, implicit like a real
-  interval(double lo, double hi) : x_(lo, hi) {}
-  explicit interval(const boost_interval& b) : x_(b) {}
+  boost_interval() : x_(0.0) {}
+  boost_interval(double v) : x_(v) {}  // NOLINT: a point interval, implicit like a real
+  boost_interval(double lo, double hi) : x_(lo, hi) {}
+  explicit boost_interval(const boost_interval_base& b) : x_(b) {}
 
   double lower() const { return x_.lower(); }
   double upper() const { return x_.upper(); }
   double width() const { return x_.upper() - x_.lower(); }
-  const boost_interval& boost() const { return x_; }
+  const boost_interval_base& boost() const { return x_; }
 
-  interval& operator+=(const interval& o) { x_ += o.x_; return *this; }
-  interval& operator-=(const interval& o) { x_ -= o.x_; return *this; }
-  interval& operator*=(const interval& o) { x_ *= o.x_; return *this; }
-  interval& operator/=(const interval& o) { x_ /= o.x_; return *this; }
-  friend interval operator+(const interval& a, const interval& b) { return interval(a.x_ + b.x_); }
-  friend interval operator-(const interval& a, const interval& b) { return interval(a.x_ - b.x_); }
-  friend interval operator*(const interval& a, const interval& b) { return interval(a.x_ * b.x_); }
-  friend interval operator/(const interval& a, const interval& b) { return interval(a.x_ / b.x_); }
-  friend interval operator-(const interval& a) { return interval(-a.x_); }
-  friend interval operator+(const interval& a) { return a; }
+  boost_interval& operator+=(const boost_interval& o) { x_ += o.x_; return *this; }
+  boost_interval& operator-=(const boost_interval& o) { x_ -= o.x_; return *this; }
+  boost_interval& operator*=(const boost_interval& o) { x_ *= o.x_; return *this; }
+  boost_interval& operator/=(const boost_interval& o) { x_ /= o.x_; return *this; }
+  friend boost_interval operator+(const boost_interval& a, const boost_interval& b) { return boost_interval(a.x_ + b.x_); }
+  friend boost_interval operator-(const boost_interval& a, const boost_interval& b) { return boost_interval(a.x_ - b.x_); }
+  friend boost_interval operator*(const boost_interval& a, const boost_interval& b) { return boost_interval(a.x_ * b.x_); }
+  friend boost_interval operator/(const boost_interval& a, const boost_interval& b) { return boost_interval(a.x_ / b.x_); }
+  friend boost_interval operator-(const boost_interval& a) { return boost_interval(-a.x_); }
+  friend boost_interval operator+(const boost_interval& a) { return a; }
 
   // Boost's "certainly" comparisons: true or false when decided, else they throw
   // boost::numeric::interval_lib::comparison_error. nhdyn's algorithms never call them.
-  friend bool operator<(const interval& a, const interval& b) { return a.x_ < b.x_; }
-  friend bool operator>(const interval& a, const interval& b) { return a.x_ > b.x_; }
-  friend bool operator<=(const interval& a, const interval& b) { return a.x_ <= b.x_; }
-  friend bool operator>=(const interval& a, const interval& b) { return a.x_ >= b.x_; }
-  friend bool operator==(const interval& a, const interval& b) { return a.x_ == b.x_; }
-  friend bool operator!=(const interval& a, const interval& b) { return a.x_ != b.x_; }
+  friend bool operator<(const boost_interval& a, const boost_interval& b) { return a.x_ < b.x_; }
+  friend bool operator>(const boost_interval& a, const boost_interval& b) { return a.x_ > b.x_; }
+  friend bool operator<=(const boost_interval& a, const boost_interval& b) { return a.x_ <= b.x_; }
+  friend bool operator>=(const boost_interval& a, const boost_interval& b) { return a.x_ >= b.x_; }
+  friend bool operator==(const boost_interval& a, const boost_interval& b) { return a.x_ == b.x_; }
+  friend bool operator!=(const boost_interval& a, const boost_interval& b) { return a.x_ != b.x_; }
 
-  friend interval sin(const interval& a) { return interval(boost::numeric::sin(a.x_)); }
-  friend interval cos(const interval& a) { return interval(boost::numeric::cos(a.x_)); }
-  friend interval tan(const interval& a) { return interval(boost::numeric::tan(a.x_)); }
-  friend interval sqrt(const interval& a) { return interval(boost::numeric::sqrt(a.x_)); }
-  friend interval exp(const interval& a) { return interval(boost::numeric::exp(a.x_)); }
-  friend interval log(const interval& a) { return interval(boost::numeric::log(a.x_)); }
-  friend interval atan(const interval& a) { return interval(boost::numeric::atan(a.x_)); }
-  friend interval abs(const interval& a) { return interval(boost::numeric::abs(a.x_)); }
-  friend interval square(const interval& a) { return interval(boost::numeric::square(a.x_)); }
-  friend interval pow(const interval& a, int p) { return interval(boost::numeric::pow(a.x_, p)); }
+  friend boost_interval sin(const boost_interval& a) { return boost_interval(boost::numeric::sin(a.x_)); }
+  friend boost_interval cos(const boost_interval& a) { return boost_interval(boost::numeric::cos(a.x_)); }
+  friend boost_interval tan(const boost_interval& a) { return boost_interval(boost::numeric::tan(a.x_)); }
+  friend boost_interval sqrt(const boost_interval& a) { return boost_interval(boost::numeric::sqrt(a.x_)); }
+  friend boost_interval exp(const boost_interval& a) { return boost_interval(boost::numeric::exp(a.x_)); }
+  friend boost_interval log(const boost_interval& a) { return boost_interval(boost::numeric::log(a.x_)); }
+  friend boost_interval atan(const boost_interval& a) { return boost_interval(boost::numeric::atan(a.x_)); }
+  friend boost_interval abs(const boost_interval& a) { return boost_interval(boost::numeric::abs(a.x_)); }
+  friend boost_interval square(const boost_interval& a) { return boost_interval(boost::numeric::square(a.x_)); }
+  friend boost_interval pow(const boost_interval& a, int p) { return boost_interval(boost::numeric::pow(a.x_, p)); }
   /// The smallest interval containing a and b.
-  friend interval hull(const interval& a, const interval& b) {
-    return interval(boost::numeric::hull(a.x_, b.x_));
+  friend boost_interval hull(const boost_interval& a, const boost_interval& b) {
+    return boost_interval(boost::numeric::hull(a.x_, b.x_));
   }
   /// True if x ∈ a.
-  friend bool contains(const interval& a, double x) { return a.lower() <= x && x <= a.upper(); }
+  friend bool contains(const boost_interval& a, double x) { return a.lower() <= x && x <= a.upper(); }
 
  private:
-  boost_interval x_;
+  boost_interval_base x_;
+};
+
+namespace detail {
+/// Below x by at least one ulp, for any x (Rump et al. 2009; see the file comment):
+/// x − (φ|x| + η). Rump's η is the smallest subnormal; any larger η is as sound and only
+/// widens more, and η = 2⁻⁵⁰⁰ (3e-151) keeps the bounds of near-zero quantities (a joint at
+/// rest: [−η, η]) and their products normal numbers — subnormal arithmetic costs x86 about
+/// 100 cycles per operation. Finite x; −∞ stays, +∞ gives NaN (reported as unbounded).
+[[gnu::always_inline]] inline double pred(double x) {
+  constexpr double phi = 0x1.0000000000001p-53, eta = 0x1p-500;
+  return x - (std::abs(x) * phi + eta);
+}
+[[gnu::always_inline]] inline double succ(double x) {
+  constexpr double phi = 0x1.0000000000001p-53, eta = 0x1p-500;
+  return x + (std::abs(x) * phi + eta);
+}
+}  // namespace detail
+
+/// nhdyn's interval (see the file comment): [lo, hi] as two doubles, arithmetic here,
+/// library functions through Boost.Interval.
+class interval {
+ public:
+  interval() : lo_(0.0), hi_(0.0) {}
+  interval(double v) : lo_(v), hi_(v) {}  // NOLINT: a point interval, implicit like a real
+  /// [lo, hi]; empty (NaN bounds) unless lo ≤ hi.
+  interval(double lo, double hi) : lo_(lo), hi_(hi) {
+    if (!(lo <= hi)) lo_ = hi_ = std::numeric_limits<double>::quiet_NaN();
+  }
+  explicit interval(const boost_interval_base& b) : lo_(b.lower()), hi_(b.upper()) {}
+  explicit interval(const boost_interval& b) : interval(b.boost()) {}
+
+  double lower() const { return lo_; }
+  double upper() const { return hi_; }
+  double width() const { return hi_ - lo_; }
+  /// The same interval as Boost's type.
+  boost_interval_base boost() const {
+    return (lo_ != lo_) ? boost_interval_base::empty() : boost_interval_base(lo_, hi_, true);
+  }
+
+  interval& operator+=(const interval& o) { return *this = *this + o; }
+  interval& operator-=(const interval& o) { return *this = *this - o; }
+  interval& operator*=(const interval& o) { return *this = *this * o; }
+  interval& operator/=(const interval& o) { return *this = *this / o; }
+
+  [[gnu::always_inline]] friend interval operator+(const interval& a, const interval& b) {
+    return raw(detail::pred(a.lo_ + b.lo_), detail::succ(a.hi_ + b.hi_));
+  }
+  [[gnu::always_inline]] friend interval operator-(const interval& a, const interval& b) {
+    return raw(detail::pred(a.lo_ - b.hi_), detail::succ(a.hi_ - b.lo_));
+  }
+  [[gnu::always_inline]] friend interval operator*(const interval& a, const interval& b) {
+    const double p1 = a.lo_ * b.lo_, p2 = a.lo_ * b.hi_, p3 = a.hi_ * b.lo_, p4 = a.hi_ * b.hi_;
+    return raw(detail::pred(std::min(std::min(p1, p2), std::min(p3, p4))),
+               detail::succ(std::max(std::max(p1, p2), std::max(p3, p4))));
+  }
+  [[gnu::always_inline]] friend interval operator/(const interval& a, const interval& b) {
+    if (!(b.lo_ > 0.0 || b.hi_ < 0.0)) {  // 0 ∈ b (or b empty)
+      const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+      return (b.lo_ != b.lo_ || a.lo_ != a.lo_) ? raw(nan, nan) : raw(-inf, inf);
+    }
+    const double p1 = a.lo_ / b.lo_, p2 = a.lo_ / b.hi_, p3 = a.hi_ / b.lo_, p4 = a.hi_ / b.hi_;
+    return raw(detail::pred(std::min(std::min(p1, p2), std::min(p3, p4))),
+               detail::succ(std::max(std::max(p1, p2), std::max(p3, p4))));
+  }
+  // Mixed with a double constant c (a model parameter): two products, not four.
+  [[gnu::always_inline]] friend interval operator*(const interval& a, double c) {
+    const double p1 = a.lo_ * c, p2 = a.hi_ * c;
+    return raw(detail::pred(std::min(p1, p2)), detail::succ(std::max(p1, p2)));
+  }
+  [[gnu::always_inline]] friend interval operator*(double c, const interval& a) { return a * c; }
+  [[gnu::always_inline]] friend interval operator+(const interval& a, double c) {
+    return raw(detail::pred(a.lo_ + c), detail::succ(a.hi_ + c));
+  }
+  [[gnu::always_inline]] friend interval operator+(double c, const interval& a) { return a + c; }
+  [[gnu::always_inline]] friend interval operator-(const interval& a, double c) {
+    return raw(detail::pred(a.lo_ - c), detail::succ(a.hi_ - c));
+  }
+  [[gnu::always_inline]] friend interval operator-(double c, const interval& a) {
+    return raw(detail::pred(c - a.hi_), detail::succ(c - a.lo_));
+  }
+  [[gnu::always_inline]] friend interval operator/(const interval& a, double c) { return a / interval(c); }
+  [[gnu::always_inline]] friend interval operator-(const interval& a) { return raw(-a.hi_, -a.lo_); }
+  [[gnu::always_inline]] friend interval operator+(const interval& a) { return a; }
+
+  // Boost's "certainly" comparisons: true or false when decided, else they throw
+  // boost::numeric::interval_lib::comparison_error. nhdyn's algorithms never call them.
+  friend bool operator<(const interval& a, const interval& b) { return a.boost() < b.boost(); }
+  friend bool operator>(const interval& a, const interval& b) { return a.boost() > b.boost(); }
+  friend bool operator<=(const interval& a, const interval& b) { return a.boost() <= b.boost(); }
+  friend bool operator>=(const interval& a, const interval& b) { return a.boost() >= b.boost(); }
+  friend bool operator==(const interval& a, const interval& b) { return a.boost() == b.boost(); }
+  friend bool operator!=(const interval& a, const interval& b) { return a.boost() != b.boost(); }
+
+  /// (sin a, cos a) together, from one evaluation of the kernel at each end (see the file
+  /// comment for how they are enclosed).
+  friend std::pair<interval, interval> sincos_pair(const interval& a) {
+    std::pair<interval, interval> r;
+    if (in_kernel_range(a)) {
+      const auto fl = detail::sincos_kernel(a.lo_), fh = detail::sincos_kernel(a.hi_);
+      // sin is monotonic between its extrema π/2 + jπ, cos between jπ.
+      if (!monotonic_piece(a, 0.5, fl.s, fh.s, r.first)) r.first = interval(boost::numeric::sin(a.boost()));
+      if (!monotonic_piece(a, 0.0, fl.c, fh.c, r.second)) r.second = interval(boost::numeric::cos(a.boost()));
+      return r;
+    }
+    return {interval(boost::numeric::sin(a.boost())), interval(boost::numeric::cos(a.boost()))};
+  }
+  friend interval sin(const interval& a) { return sincos_pair(a).first; }
+  friend interval cos(const interval& a) { return sincos_pair(a).second; }
+  friend interval tan(const interval& a) { return interval(boost::numeric::tan(a.boost())); }
+  friend interval sqrt(const interval& a) { return interval(boost::numeric::sqrt(a.boost())); }
+  friend interval exp(const interval& a) { return interval(boost::numeric::exp(a.boost())); }
+  friend interval log(const interval& a) { return interval(boost::numeric::log(a.boost())); }
+  friend interval atan(const interval& a) { return interval(boost::numeric::atan(a.boost())); }
+  friend interval abs(const interval& a) { return interval(boost::numeric::abs(a.boost())); }
+  friend interval square(const interval& a) { return interval(boost::numeric::square(a.boost())); }
+  friend interval pow(const interval& a, int p) { return interval(boost::numeric::pow(a.boost(), p)); }
+  /// The smallest interval containing a and b.
+  friend interval hull(const interval& a, const interval& b) {
+    return interval(boost::numeric::hull(a.boost(), b.boost()));
+  }
+  /// True if x ∈ a.
+  friend bool contains(const interval& a, double x) { return a.lo_ <= x && x <= a.hi_; }
+
+ private:
+  [[gnu::always_inline]] static interval raw(double lo, double hi) {
+    interval r;
+    r.lo_ = lo;
+    r.hi_ = hi;
+    return r;
+  }
+  static bool in_kernel_range(const interval& a) {
+    return std::abs(a.lo_) <= 1e5 && std::abs(a.hi_) <= 1e5 && a.lo_ <= a.hi_;
+  }
+  /// f = sin (shift 1/2) or cos (shift 0) over a, given the kernel's f at both ends: when
+  /// t = x/π − shift lies in one (j, j + 1) for all of a, 1e-9 clear of both ends (t is
+  /// computed with an error below 1e-10 for |x| ≤ 1e5), f is monotonic on a. Returns false
+  /// (use Boost) otherwise.
+  static bool monotonic_piece(const interval& a, double shift, double vl, double vh, interval& r);
+
+  double lo_, hi_;
 };
 
 /// [lo, hi] widened by one ulp each side: encloses the real numbers lo and hi stood for
@@ -192,21 +345,42 @@ inline interval relative(double x, double f) {
   return outward(std::min(a, b), std::max(a, b));
 }
 
-template <>
-struct scalar_traits<interval> {
+namespace detail {
+template <class I>
+struct interval_traits {
   /// The midpoint (NaN for an empty interval).
-  static double value(const interval& x) {
-    return boost::numeric::empty(x.boost()) ? std::numeric_limits<double>::quiet_NaN()
-                                            : 0.5 * x.lower() + 0.5 * x.upper();
+  static double value(const I& x) {
+    return x.lower() != x.lower() ? std::numeric_limits<double>::quiet_NaN() : 0.5 * x.lower() + 0.5 * x.upper();
   }
-  static bool is_exact_zero(const interval& x) { return x.lower() == 0.0 && x.upper() == 0.0; }
+  static bool is_exact_zero(const I& x) { return x.lower() == 0.0 && x.upper() == 0.0; }
   /// Both bounds finite (an empty or unbounded enclosure is not).
-  static bool is_finite(const interval& x) {
+  static bool is_finite(const I& x) {
     return std::isfinite(x.lower()) && std::isfinite(x.upper()) && x.lower() <= x.upper();
   }
 };
+}  // namespace detail
+
+template <>
+struct scalar_traits<interval> : detail::interval_traits<interval> {};
+template <>
+struct scalar_traits<boost_interval> : detail::interval_traits<boost_interval> {};
 
 inline bool isfinite(const interval& x) { return scalar_traits<interval>::is_finite(x); }
+inline bool isfinite(const boost_interval& x) { return scalar_traits<boost_interval>::is_finite(x); }
+
+inline bool interval::monotonic_piece(const interval& a, double shift, double vl, double vh, interval& r) {
+  constexpr double inv_pi = 0.31830988618379067154, margin = 1e-9;
+  const double tl = a.lo_ * inv_pi - shift, th = a.hi_ * inv_pi - shift;
+  const double jl = std::floor(tl), jh = std::floor(th);
+  if (jl != jh || tl - jl < margin || jl + 1 - th < margin) return false;
+  // On an even piece f decreases (sin over (π/2, 3π/2), cos over (0, π)); on an odd one it
+  // increases.
+  const bool decreasing = std::fmod(jl, 2.0) == 0.0;
+  const double a0 = decreasing ? vh : vl, b0 = decreasing ? vl : vh;
+  constexpr double err = 4.5e-16;  // ≥ twice the kernel's error bound (< 1 ulp ≤ 2.3e-16)
+  r = raw(std::max(-1.0, detail::pred(a0 - err)), std::min(1.0, detail::succ(b0 + err)));
+  return true;
+}
 
 }  // namespace nhdyn
 
@@ -219,15 +393,19 @@ inline std::ostream& operator<<(std::ostream& os, const nhdyn::interval& x) {
   os.precision(p);
   return os;
 }
+inline std::ostream& operator<<(std::ostream& os, const nhdyn::boost_interval& x) {
+  return os << nhdyn::interval(x);
+}
 }  // namespace nhdyn
 
 namespace Eigen {
-template <>
-struct NumTraits<nhdyn::interval> : NumTraits<double> {
-  using Real = nhdyn::interval;
-  using NonInteger = nhdyn::interval;
-  using Nested = nhdyn::interval;
-  using Literal = nhdyn::interval;
+namespace nhdyn_detail {
+template <class I>
+struct interval_num_traits : NumTraits<double> {
+  using Real = I;
+  using NonInteger = I;
+  using Nested = I;
+  using Literal = I;
   enum {
     IsComplex = 0,
     IsInteger = 0,
@@ -243,6 +421,11 @@ struct NumTraits<nhdyn::interval> : NumTraits<double> {
   static inline Real lowest() { return Real(NumTraits<double>::lowest()); }
   static inline int digits10() { return NumTraits<double>::digits10(); }
 };
+}  // namespace nhdyn_detail
+template <>
+struct NumTraits<nhdyn::interval> : nhdyn_detail::interval_num_traits<nhdyn::interval> {};
+template <>
+struct NumTraits<nhdyn::boost_interval> : nhdyn_detail::interval_num_traits<nhdyn::boost_interval> {};
 template <typename BinaryOp>
 struct ScalarBinaryOpTraits<nhdyn::interval, double, BinaryOp> {
   using ReturnType = nhdyn::interval;
@@ -250,5 +433,13 @@ struct ScalarBinaryOpTraits<nhdyn::interval, double, BinaryOp> {
 template <typename BinaryOp>
 struct ScalarBinaryOpTraits<double, nhdyn::interval, BinaryOp> {
   using ReturnType = nhdyn::interval;
+};
+template <typename BinaryOp>
+struct ScalarBinaryOpTraits<nhdyn::boost_interval, double, BinaryOp> {
+  using ReturnType = nhdyn::boost_interval;
+};
+template <typename BinaryOp>
+struct ScalarBinaryOpTraits<double, nhdyn::boost_interval, BinaryOp> {
+  using ReturnType = nhdyn::boost_interval;
 };
 }  // namespace Eigen
