@@ -12,41 +12,19 @@
 #include <cstdlib>
 #include <cstring>
 #include <nhdyn/nhdyn.hpp>
+#include <nhdyn/simulation/free_motion.hpp>
 #include <nhdyn/simulation/integrators.hpp>
 #include <vector>
 
 using namespace nhdyn;
 
 namespace {
-struct unforced {
-  robot<double, 5, differential_drive<double, 5>> rb = presets::paper5<double>();
-  kinematics<double, 5> kin{rb.chain};
-  nh_forward_dynamics_fn<double, 5, differential_drive<double, 5>> fd = nh_forward_dynamics(rb.chain, rb.constraint);
-
-  auto rhs() const {
-    return [this](const auto& t, const auto& x) {
-      using T = std::decay_t<decltype(t)>;
-      const vecN<T, 5> q = x.template head<5>();
-      const vecN<T, 4> eta = x.template tail<4>();
-      vecN<T, 9> dx;
-      dx << apply_S(rb.constraint, q, eta), fd(q, eta, vecN<T, 4>::Zero());
-      return dx;
-    };
-  }
-  /// E = ½ ηᵀ M_η η + Σ m_i g · height of c_i (x₀ points up: gravity is −9.81 x₀).
-  double energy(const vecN<double, 9>& x) const {
-    const vecN<double, 5> q = x.head<5>();
-    const vecN<double, 4> eta = x.tail<4>();
-    double V = 0;
-    for (int i = 0; i < 5; ++i) V += rb.chain[i].mass * 9.81 * kin.point(q, i + 1, rb.chain[i].com)(0);
-    return 0.5 * eta.dot(fd.reduced_inertia(q) * eta) + V;
-  }
-  double constraint_residual(const vecN<double, 9>& x) const {
-    const vecN<double, 5> q = x.head<5>();
-    const vecN<double, 4> eta = x.tail<4>();
-    return (rb.constraint.A(q) * apply_S(rb.constraint, q, eta)).cwiseAbs().maxCoeff();
-  }
-};
+/// paper5, unforced (simulation/free_motion.hpp).
+using unforced = free_motion<double, 5, differential_drive<double, 5>>;
+inline unforced make_unforced() {
+  const auto r = presets::paper5<double>();
+  return unforced(r.chain, r.constraint);
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -56,7 +34,7 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--quick") == 0) quick = true;
     else t_end = std::atof(argv[i]);
   }
-  const unforced u;
+  const unforced u = make_unforced();
   vecN<double, 9> x0;
   x0 << -0.2, 1.0, 2.8, 1.9, 1.1, 0.5, -0.8, 2.0, -3.0;  // driving, turning, arm swinging
   const double E0 = u.energy(x0);

@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <nhdyn/nhdyn.hpp>
+#include <nhdyn/simulation/free_motion.hpp>
 #include <nhdyn/simulation/simulation.hpp>
 
 using namespace nhdyn;
@@ -41,28 +42,12 @@ timing best_of(int n, F&& f) {
   return best;
 }
 
-struct unforced {
-  robot<double, 5, differential_drive<double, 5>> rb = presets::paper5<double>();
-  kinematics<double, 5> kin{rb.chain};
-  nh_forward_dynamics_fn<double, 5, differential_drive<double, 5>> fd = nh_forward_dynamics(rb.chain, rb.constraint);
-  auto rhs() const {
-    return [this](const auto& t, const auto& x) {
-      using T = std::decay_t<decltype(t)>;
-      const vecN<T, 5> q = x.template head<5>();
-      const vecN<T, 4> eta = x.template tail<4>();
-      vecN<T, 9> dx;
-      dx << apply_S(rb.constraint, q, eta), fd(q, eta, vecN<T, 4>::Zero());
-      return dx;
-    };
-  }
-  double energy(const vecN<double, 9>& x) const {
-    const vecN<double, 5> q = x.head<5>();
-    const vecN<double, 4> eta = x.tail<4>();
-    double V = 0;
-    for (int i = 0; i < 5; ++i) V += rb.chain[i].mass * 9.81 * kin.point(q, i + 1, rb.chain[i].com)(0);
-    return 0.5 * eta.dot(fd.reduced_inertia(q) * eta) + V;
-  }
-};
+/// paper5, unforced (simulation/free_motion.hpp).
+using unforced = free_motion<double, 5, differential_drive<double, 5>>;
+inline unforced make_unforced() {
+  const auto r = presets::paper5<double>();
+  return unforced(r.chain, r.constraint);
+}
 
 struct outcome {
   vecN<double, 9> x;
@@ -102,7 +87,7 @@ double position_error(const vecN<double, 9>& a, const vecN<double, 9>& b) {
 }  // namespace
 
 int main() {
-  const unforced u;
+  const unforced u = make_unforced();
   std::vector<integrator_options> cases;
   for (double h : {8e-3, 4e-3, 2e-3, 1e-3, 5e-4, 2.5e-4}) cases.push_back({method::rk4, h});
   for (double tol : {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11})

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 #include <nhdyn/nhdyn.hpp>
+#include <nhdyn/simulation/free_motion.hpp>
 #include <nhdyn/simulation/scene.hpp>
 #include <nhdyn/simulation/simulation.hpp>
 
@@ -18,30 +19,12 @@ std::string scene_file(const std::string& name) {
   return std::string(src ? src : ".") + "/examples/scenes/" + name + ".json";
 }
 
-// Unforced paper5 (τ = 0, gravity on): E = ½ ηᵀM_η η + Σ m_i g_up · x_ci (x₀ points up).
-struct unforced {
-  robot<double, 5, differential_drive<double, 5>> rb = presets::paper5<double>();
-  kinematics<double, 5> kin{rb.chain};
-  nh_forward_dynamics_fn<double, 5, differential_drive<double, 5>> fd = nh_forward_dynamics(rb.chain, rb.constraint);
-
-  auto rhs() const {
-    return [this](const auto& t, const auto& x) {
-      using T = std::decay_t<decltype(t)>;
-      const vecN<T, 5> q = x.template head<5>();
-      const vecN<T, 4> eta = x.template tail<4>();
-      vecN<T, 9> dx;
-      dx << apply_S(rb.constraint, q, eta), fd(q, eta, vecN<T, 4>::Zero());
-      return dx;
-    };
-  }
-  double energy(const vecN<double, 9>& x) const {
-    const vecN<double, 5> q = x.head<5>();
-    const vecN<double, 4> eta = x.tail<4>();
-    double V = 0;
-    for (int i = 0; i < 5; ++i) V += rb.chain[i].mass * 9.81 * kin.point(q, i + 1, rb.chain[i].com)(0);
-    return 0.5 * eta.dot(fd.reduced_inertia(q) * eta) + V;
-  }
-};
+/// paper5, unforced (simulation/free_motion.hpp).
+using unforced = free_motion<double, 5, differential_drive<double, 5>>;
+inline unforced make_unforced() {
+  const auto r = presets::paper5<double>();
+  return unforced(r.chain, r.constraint);
+}
 
 vecN<double, 9> moving_start() {
   vecN<double, 9> x;
@@ -51,7 +34,7 @@ vecN<double, 9> moving_start() {
 }  // namespace
 
 TEST_CASE("simulation: the unforced undamped constrained robot conserves energy, less drift at tighter tolerance") {
-  const unforced u;
+  const unforced u = make_unforced();
   const vecN<double, 9> x0 = moving_start();
   const double E0 = u.energy(x0);
   std::vector<double> out;
@@ -76,7 +59,7 @@ TEST_CASE("simulation: the unforced undamped constrained robot conserves energy,
 }
 
 TEST_CASE("simulation: the integrated base path never slips sideways (ṗ_b · z₃ = 0)") {
-  const unforced u;
+  const unforced u = make_unforced();
   std::vector<double> out;
   for (int i = 0; i <= 2000; ++i) out.push_back(0.001 * i);
   std::vector<vecN<double, 9>> xs;

@@ -19,13 +19,9 @@ constexpr std::string_view usage = R"(nhdyn fd --model MODEL
 )";
 
 int run(const std::vector<std::string>& args) {
-  const auto o = parse_options(args, {"model"});
-  if (o.help) {
-    std::cout << usage;
-    return 0;
-  }
-  if (!o.positional.empty()) throw usage_error("unexpected argument '" + o.positional[0] + "'");
-  const auto m = load_model_option(o);
+  const auto model = start_model_command(args, usage);
+  if (!model) return 0;  // --help
+  const auto& m = *model;
   const auto& ch = m.chain;
   const int n = ch.dof();
   if (!m.constraint) {

@@ -62,6 +62,17 @@ nhdyn::io::model<double> load_model_option(const options& o) {
   return nhdyn::io::load<double>(o.required("model"));
 }
 
+std::optional<nhdyn::io::model<double>> start_model_command(const std::vector<std::string>& args,
+                                                            std::string_view usage) {
+  const auto o = parse_options(args, {"model"});
+  if (o.help) {
+    std::cout << usage;
+    return std::nullopt;
+  }
+  if (!o.positional.empty()) throw usage_error("unexpected argument '" + o.positional[0] + "'");
+  return load_model_option(o);
+}
+
 // ---------------------------------------------------------------------------------------
 
 namespace {

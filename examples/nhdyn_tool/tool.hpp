@@ -5,12 +5,13 @@
 ///
 /// Adding a subcommand: write examples/nhdyn_tool/<name>.cpp defining
 /// `nhdyn_tool::command nhdyn_tool::command_<name>()`, and add `X(<name>)` to the list in
-/// main.cpp. A line-oriented subcommand parses its options with `parse_options`, loads the
-/// model with `load_model_option`, and hands a `line_handler` to `run_lines`.
+/// main.cpp. A line-oriented subcommand starts with `start_model_command` (or, with more
+/// options, `parse_options` and `load_model_option`), and hands a `line_handler` to `run_lines`.
 #include <Eigen/Core>
 #include <functional>
 #include <iosfwd>
 #include <map>
+#include <optional>
 #include <nhdyn/io/json.hpp>
 #include <string>
 #include <string_view>
@@ -53,6 +54,12 @@ options parse_options(const std::vector<std::string>& args, const std::vector<st
 /// The model named by --model (a preset name or a file path). Throws nhdyn::error with a
 /// message naming the file, link and field.
 nhdyn::io::model<double> load_model_option(const options& o);
+
+/// The start of every line-oriented subcommand whose only option is --model: parses args,
+/// answers --help by printing `usage` (then returns no model: the subcommand exits 0),
+/// rejects positional arguments (usage_error), and loads the model.
+std::optional<nhdyn::io::model<double>> start_model_command(const std::vector<std::string>& args,
+                                                            std::string_view usage);
 
 // ---------------------------------------------------------------------------------------
 // Lines

@@ -4,7 +4,7 @@
 /// point r ∈ R³ on the last link, as paper5.md uses it:
 ///
 ///     r̃ = r_d − r,  dr̃/dt = ṙ_d − B η,  e = (r̃, dr̃/dt) ∈ R⁶,  H = [0; −I₃]
-///     δ   = −ρ(e) Hᵀ P e / max(‖Hᵀ P e‖, ε)   (0 where Hᵀ P e = 0)             (eq. 26–28)
+///     δ   = −ρ(e) Hᵀ P e / max(‖Hᵀ P e‖, ε)   (0 where Hᵀ P e = 0)        (eq. 23–28)
 ///     ρ(e) = (γ₂‖e‖² + γ₁‖e‖ + γ₀) / (1 − α)
 ///     a_r = r̈_d + K₁ dr̃/dt + K₀ r̃ + δ                                          (eq. 23)
 ///     a   = B⁺(a_r − Ḃη) + (I − B⁺B) z,   B⁺ = Bᵀ(BBᵀ + λ²I)⁻¹                 (eq. 30, damped)
@@ -114,7 +114,7 @@ class rac_controller {
   const Eigen::Matrix<double, 6, 6>& P() const { return P_; }
   const rac_gains& gains() const { return g_; }
 
-  /// The robust term δ(e) (eq. 26–28).
+  /// The robust term δ(e) (the outer loop, eq. 23–28).
   template <class T>
   vec3<T> delta(const Eigen::Matrix<T, 6, 1>& e) const {
     using std::sqrt;
