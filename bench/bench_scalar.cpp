@@ -2,7 +2,11 @@
 //   scalar/<algorithm>/<model>/<scalar>   algorithm ∈ {rne, nh_id}, model ∈ {paper5, chain24}
 //       counters: rel_err = max over 64 ordinary states of |τ − τ₅₀|/max|τ₅₀| (value part for
 //       duals/autodiff, midpoint for intervals, whose counter width = max enclosure width);
-//   scalar/jacobian/paper5/{dual,autodiff,central}: the full ∂τ/∂ζ (4×13) of paper5;
+//   scalar/nh_id/<model>/<scalar>_state: the double model on an S state (interval: bounds
+//       over a box of states; the plain <scalar> row has the model in S too);
+//   scalar/jacobian/paper5/{dual,dual_oneshot,dual_all_columns,autodiff,central}: the full
+//       ∂τ/∂ζ (4×13) of paper5 (dual: inverse_dynamics_linearizer built once; oneshot:
+//       linearize_inverse_dynamics per call; all_columns: jacobian() seeding all 13);
 //   scalar/bounds/paper5/split:k: interval enclosure over a state box, counter width.
 // chain24 is paper5's differential-drive base carrying a 21-joint random arm (bench/models.hpp).
 // The 50-digit reference is cross-checked at start-up: rne₅₀ against the CRBA path
@@ -103,7 +107,7 @@ double mid(const S& x) {
 }
 template <class S>
 double width(const S& x) {
-  if constexpr (std::is_same_v<S, interval>) return x.width();
+  if constexpr (std::is_same_v<S, interval> || std::is_same_v<S, nhdyn::boost_interval>) return x.width();
   else return 0.0;
 }
 
@@ -150,9 +154,14 @@ void bm_rne(benchmark::State& st) {
   if (w > 0) st.counters["rel_width"] = w;
 }
 
-template <class S, int N>
+/// ModelInS: the model's numbers in S too (e.g. an interval model: uncertain parameters);
+/// otherwise a double model evaluated on an S state (e.g. bounds over a box of states).
+template <class S, int N, bool ModelInS = true>
 void bm_nh_id(benchmark::State& st) {
-  const auto c = model<N>().template cast<S>();
+  const auto c = [] {
+    if constexpr (ModelInS) return model<N>().template cast<S>();
+    else return model<N>();
+  }();
   const auto id = nhdyn::inverse_dynamics(c, constraint<N>());
   const auto& s = state_set<N>();
   std::vector<Eigen::Matrix<S, N, 1>> q;
@@ -184,18 +193,50 @@ void register_scalar(const char* name) {
   benchmark::RegisterBenchmark((std::string("scalar/rne/chain24/") + name).c_str(), bm_rne<S, n24>);
   benchmark::RegisterBenchmark((std::string("scalar/nh_id/chain24/") + name).c_str(), bm_nh_id<S, n24>);
 }
+/// An S state on the double model: <name>_state.
+template <class S>
+void register_state_scalar(const std::string& name) {
+  benchmark::RegisterBenchmark(("scalar/nh_id/paper5/" + name + "_state").c_str(), bm_nh_id<S, 5, false>);
+  benchmark::RegisterBenchmark(("scalar/nh_id/chain24/" + name + "_state").c_str(), bm_nh_id<S, n24, false>);
+}
 
 // ---- the full Jacobian ∂τ/∂ζ of paper5 (4 × 13)
 using V5 = Eigen::Matrix<double, 5, 1>;
 using V4 = Eigen::Matrix<double, 4, 1>;
 using V13 = Eigen::Matrix<double, 13, 1>;
 
+/// The linearizer built once, as the double inverse dynamics it is compared with is.
 void bm_jacobian_dual(benchmark::State& st) {
+  const nhdyn::inverse_dynamics_linearizer lin(paper5(), constraint<5>());
+  const auto& s = state_set<5>();
+  std::size_t k = 0;
+  for (auto _ : st) {
+    auto J = lin(s.q[k], s.eta[k], s.etad[k]);
+    benchmark::DoNotOptimize(J);
+    k = (k + 1) & 63;
+  }
+}
+/// linearize_inverse_dynamics: builds the pipeline in every call.
+void bm_jacobian_dual_oneshot(benchmark::State& st) {
   const auto c = constraint<5>();
   const auto& s = state_set<5>();
   std::size_t k = 0;
   for (auto _ : st) {
     auto J = nhdyn::linearize_inverse_dynamics(paper5(), c, s.q[k], s.eta[k], s.etad[k]);
+    benchmark::DoNotOptimize(J);
+    k = (k + 1) & 63;
+  }
+}
+/// Every column seeded (dual<double, 13>): what the skipped base columns save.
+void bm_jacobian_dual_all_columns(benchmark::State& st) {
+  const auto id = nhdyn::inverse_dynamics(paper5(), constraint<5>());
+  const auto f = [&](const auto& z) { return id(z.template head<5>(), z.template segment<4>(5), z.template tail<4>()); };
+  const auto& s = state_set<5>();
+  std::size_t k = 0;
+  for (auto _ : st) {
+    Eigen::Matrix<double, 13, 1> z;
+    z << s.q[k], s.eta[k], s.etad[k];
+    auto J = nhdyn::jacobian(f, z);
     benchmark::DoNotOptimize(J);
     k = (k + 1) & 63;
   }
@@ -283,7 +324,13 @@ const bool registered = [] {
   register_scalar<dual13>("dual13");
   register_scalar<ad13>("autodiff13");
   register_scalar<interval>("interval");
+  register_scalar<nhdyn::boost_interval>("boost_interval");
+  register_state_scalar<interval>("interval");
+  register_state_scalar<nhdyn::boost_interval>("boost_interval");
+  register_state_scalar<dual13>("dual13");
   benchmark::RegisterBenchmark("scalar/jacobian/paper5/dual", bm_jacobian_dual);
+  benchmark::RegisterBenchmark("scalar/jacobian/paper5/dual_oneshot", bm_jacobian_dual_oneshot);
+  benchmark::RegisterBenchmark("scalar/jacobian/paper5/dual_all_columns", bm_jacobian_dual_all_columns);
   benchmark::RegisterBenchmark("scalar/jacobian/paper5/autodiff", bm_jacobian_autodiff);
   benchmark::RegisterBenchmark("scalar/jacobian/paper5/central", bm_jacobian_central);
   for (int k : {0, 2, 4, 6, 8, 10})

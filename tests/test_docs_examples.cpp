@@ -5,6 +5,8 @@
 // finite differences, hand-written S and Ṡ from paper5.md, power balance.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <nhdyn/analysis/bounds.hpp>
+#include <nhdyn/analysis/linearize.hpp>
 #include <nhdyn/io/json.hpp>
 #include <nhdyn/nhdyn.hpp>
 #include <numbers>
@@ -95,6 +97,9 @@ Eigen::VectorXd rne_as_documented(const nhdyn::chain<double>& ch, const Eigen::V
 }
 
 double rel(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return (a - b).norm() / std::max(1.0, b.norm());
+}
+double relm(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a - b).norm() / std::max(1.0, b.norm());
 }
 
@@ -476,5 +481,51 @@ TEST_CASE("docs/api.md §2: a model read from JSON text gives the pendulum's clo
     FAIL("no model_error thrown");
   } catch (const nhdyn::model_error& e) {
     CHECK_THAT(e.what(), Catch::Contains("link 1, field 'com'"));
+  }
+}
+
+TEST_CASE("docs/api.md §10: the linearizer, the state-space linearisation and torque bounds") {
+  const vec5 q(0.3, -0.2, 0.7, 0.8, -1.0);
+  const vec4 eta(0.5, 0.2, 1.0, -0.5), eta_dot(0.4, -0.1, 2.0, 1.0);
+  const vec4 tau(3.0, -1.0, 2.0, 0.5);
+  // snippet
+  // #include <nhdyn/analysis/linearize.hpp>, <nhdyn/analysis/bounds.hpp>
+  const auto robot = nhdyn::presets::paper5();
+  // ∂τ/∂(q, η, η̇) by duals, the pipeline built once (like inverse_dynamics):
+  const nhdyn::inverse_dynamics_linearizer lin(robot.chain, robot.constraint);
+  const auto J = lin(q, eta, eta_dot);  // J.J: 4 × 13; J.dq(), J.deta(), J.deta_dot() (= M_η)
+  // ẋ = f(x, u) with x = (q, η), u = τ: A = ∂f/∂x (9 × 9), B = ∂f/∂u (9 × 4).
+  const auto ss = nhdyn::linearize_forward_dynamics(robot.chain, robot.constraint, q, eta, tau);
+  // Every τ for every state in a box (±0.01 about the state), rounded outward; 2 bisections.
+  nhdyn::box<5> Q;
+  nhdyn::box<4> H, HD;
+  for (int i = 0; i < 5; ++i) Q(i) = nhdyn::outward_about(q(i), 0.01);
+  for (int i = 0; i < 4; ++i) H(i) = nhdyn::outward_about(eta(i), 0.01), HD(i) = nhdyn::outward_about(eta_dot(i), 0.01);
+  const nhdyn::box<4> T = nhdyn::torque_bounds(robot.chain, robot.constraint, Q, H, HD, 2);
+  // T(i).lower() ≤ τ_i ≤ T(i).upper() at every point of the box
+  // end snippet
+  const auto id = nhdyn::inverse_dynamics(robot.chain, robot.constraint);
+  const auto fd = nhdyn::nh_forward_dynamics(robot.chain, robot.constraint);
+  // ∂τ/∂η̇ = M_η (the composite-rigid-body path), ∂τ/∂q by central differences.
+  CHECK(relm(J.deta_dot(), fd.reduced_inertia(q)) < 1e-13);
+  for (int j = 0; j < 5; ++j) {
+    const double h = 1e-6;
+    vec5 qp = q, qm = q;
+    qp(j) += h, qm(j) -= h;
+    const vec4 d = (id(qp, eta, eta_dot) - id(qm, eta, eta_dot)) / (2 * h);
+    CHECK(rel(J.dq().col(j), d) < 1e-7);
+  }
+  // B = [0; M_η⁻¹] (τ enters η̇ only, through M_η⁻¹ since E = S, SᵀS = I).
+  CHECK(ss.B.topRows(5).cwiseAbs().maxCoeff() == 0.0);
+  CHECK(relm(ss.B.bottomRows(4), Eigen::Matrix4d(fd.reduced_inertia(q).inverse())) < 1e-12);
+  std::mt19937_64 g(5);
+  std::uniform_real_distribution<double> u(-0.01, 0.01);
+  for (int k = 0; k < 2000; ++k) {
+    vec5 qs = q;
+    vec4 es = eta, eds = eta_dot;
+    for (int i = 0; i < 5; ++i) qs(i) += u(g);
+    for (int i = 0; i < 4; ++i) es(i) += u(g), eds(i) += u(g);
+    const vec4 t = id(qs, es, eds);
+    for (int i = 0; i < 4; ++i) REQUIRE((T(i).lower() <= t(i) && t(i) <= T(i).upper()));
   }
 }
