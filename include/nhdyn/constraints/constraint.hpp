@@ -221,20 +221,31 @@ struct differential_drive {
   }
   /// The same with sin/cos of ψ already known (the memo of lift_into).
   template <class Q, class T>
-  auto St_times_in_place(const Eigen::MatrixBase<Q>&, vecN<T, N>&& v, const detail::sin_cos<T>& p) const {
+  vecN<T, m_at_compile_time> St_times_in_place(const Eigen::MatrixBase<Q>&, vecN<T, N>&& v,
+                                               const detail::sin_cos<T>& p) const {
     const int lo = std::min(x, y), hi = std::max(x, y);
-    int c = 0;
-    for (int j = 0; j < n; ++j) {
-      if (j == lo)
-        v(c++) = p.c * v(x) + p.s * v(y);
-      else if (j != hi)
-        v(c++) = v(j);
-    }
     if constexpr (N == dynamic) {
+      int c = 0;
+      for (int j = 0; j < n; ++j) {
+        if (j == lo)
+          v(c++) = p.c * v(x) + p.s * v(y);
+        else if (j != hi)
+          v(c++) = v(j);
+      }
       v.conservativeResize(n - 1);
       return std::move(v);
     } else {
-      return vecN<T, m_at_compile_time>(v.template head<N - 1>());
+      // Fixed size: written straight into the (elided) result; compacting v and copying its
+      // head would read back just-written scalars as a vector (a store-forwarding stall).
+      vecN<T, m_at_compile_time> out;
+      int c = 0;
+      for (int j = 0; j < n; ++j) {
+        if (j == lo)
+          out(c++) = p.c * v(x) + p.s * v(y);
+        else if (j != hi)
+          out(c++) = v(j);
+      }
+      return out;
     }
   }
   /// (q̇, q̈) = (S η, S η̇ + Ṡ η) in one pass and one sin/cos of ψ, written into qd and qdd

@@ -156,7 +156,10 @@ class project_fn : public stage_tag {
   auto operator()(with_memo<generalized_forces<X, N>, Memo>&& f) const {
     if constexpr (requires { c_.St_times_in_place(f.q, std::move(f.v), f.memo); }) {
       detail::check_size(f.v, c_.dof(), "v");
-      return detail::solve_StE(c_, f.q, c_.St_times_in_place(f.q, std::move(f.v), f.memo));
+      if constexpr (C::orthonormal_S && !requires { c_.E(f.q); })
+        return c_.St_times_in_place(f.q, std::move(f.v), f.memo);  // SᵀS = I: Sᵀv is τ (no copy)
+      else
+        return detail::solve_StE(c_, f.q, c_.St_times_in_place(f.q, std::move(f.v), f.memo));
     } else {
       return (*this)(static_cast<generalized_forces<X, N>&&>(f));
     }

@@ -247,8 +247,15 @@ class rne_fn : public stage_tag {
   template <class X, class Memo>
   auto operator()(with_memo<joint_state<X, N>, Memo>&& xi) const {
     if constexpr (std::is_same_v<promote_t<S, X>, X>) {
-      run_in_place(xi);
-      return with_memo<generalized_forces<X, N>, Memo>{{std::move(xi.q), std::move(xi.qdd)}, std::move(xi.memo)};
+      // The result object first, v computed straight into it (no copy of freshly written v).
+      with_memo<generalized_forces<X, N>, Memo> out{{std::move(xi.q), {}}, std::move(xi.memo)};
+      if constexpr (N == dynamic) {
+        out.v = std::move(xi.qdd);  // q̈'s buffer, overwritten by v as in run_in_place
+        run_checked(out.q, xi.qd, out.v, out.v);
+      } else {
+        run_checked(out.q, xi.qd, xi.qdd, out.v);
+      }
+      return out;
     } else {
       return (*this)(static_cast<const joint_state<X, N>&>(xi));
     }
@@ -267,17 +274,22 @@ class rne_fn : public stage_tag {
   /// v over ξ.qdd.
   template <class X>
   void run_in_place(joint_state<X, N>& xi) const {
-    detail::check_size(xi.q, n_, "q");
-    detail::check_size(xi.qd, n_, "qd");
-    detail::check_size(xi.qdd, n_, "qdd");
-    run(xi.q, xi.qd, xi.qdd, xi.qdd);
-    // q̈ is gone (v is in its place), so a non-finite result names q or q̇ when they are the
-    // cause, and otherwise says "q̈ or overflow". Not checking q̈ before is measurable (4 ns
-    // of a 115 ns paper5 call); inside inverse_dynamics, lift has checked η̇ already.
-    for (Eigen::Index i = 0; i < xi.qdd.size(); ++i)
-      if (!is_finite_scalar(xi.qdd(i))) [[unlikely]] {
-        detail::check_finite(xi.q, "q");
-        detail::check_finite(xi.qd, "qd");
+    run_checked(xi.q, xi.qd, xi.qdd, xi.qdd);
+  }
+  /// v = rne(q, q̇, q̈) into v, which may be q̈'s storage. Then q̈ may be gone (v in its place),
+  /// so a non-finite result names q or q̇ when they are the cause, and otherwise says "q̈ or
+  /// overflow". Not checking q̈ before is measurable (4 ns of a 115 ns paper5 call); inside
+  /// inverse_dynamics, lift has checked η̇ already.
+  template <class X>
+  void run_checked(const vecN<X, N>& q, const vecN<X, N>& qd, const vecN<X, N>& qdd, vecN<X, N>& v) const {
+    detail::check_size(q, n_, "q");
+    detail::check_size(qd, n_, "qd");
+    detail::check_size(qdd, n_, "qdd");
+    run(q, qd, qdd, v);
+    for (Eigen::Index i = 0; i < v.size(); ++i)
+      if (!is_finite_scalar(v(i))) [[unlikely]] {
+        detail::check_finite(q, "q");
+        detail::check_finite(qd, "qd");
         throw numerical_error("rne: result " + std::to_string(i) +
                               " is not finite: qdd has a non-finite entry, or the computation overflowed");
       }

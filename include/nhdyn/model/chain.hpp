@@ -206,6 +206,15 @@ inline void check_finite(const V& v, const char* what) {
     if (!bad) [[likely]]
       return;
   }
+  if constexpr (requires(const T& x) { x.value(); x.derivatives(); x.derivative(0); }) {
+    // A dual input (nhdyn::dual): its values are checked here; its derivative parts are
+    // seeds, and a non-finite one would reach every result, where the algorithms' result
+    // checks report it. This keeps a linearisation's input check at one number per entry.
+    for (Eigen::Index i = 0; i < v.size(); ++i)
+      if (!is_finite_scalar(v(i).value())) [[unlikely]]
+        throw_not_finite(what, i, value_of(v(i)));
+    return;
+  }
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (!is_finite_scalar(v(i))) [[unlikely]]
       throw_not_finite(what, i, value_of(v(i)));
