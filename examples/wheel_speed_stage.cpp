@@ -10,6 +10,7 @@
 ///     wheels_out: (F, T) ↦ τ_R = r(F/2 + T/b),  τ_L = r(F/2 − T/b)
 ///
 /// (wheels_out is the transpose of wheels_in, so the power τ_R ω_R + τ_L ω_L = F v + T ω.)
+#include <cmath>
 #include <cstdio>
 #include <nhdyn/nhdyn.hpp>
 
@@ -45,5 +46,7 @@ int main() {
   const V4 tau_eta = (nhdyn::lift(robot.constraint) | nhdyn::rne(robot.chain) |
                       nhdyn::project(robot.constraint))(wheels_in(q, w, w_dot));
   const V4 eta = wheels_in(q, w, w_dot).eta;
-  std::printf("power: wheels+arm %.12f W, (F, T)-side %.12f W\n", tau.dot(w), tau_eta.dot(eta));
+  const double p_wheels = tau.dot(w), p_eta = tau_eta.dot(eta);
+  std::printf("power: wheels+arm %.12f W, (F, T)-side %.12f W\n", p_wheels, p_eta);
+  return std::abs(p_wheels - p_eta) <= 1e-12 * (1 + std::abs(p_eta)) ? 0 : 1;  // the stages conserve power
 }

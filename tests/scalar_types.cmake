@@ -1,12 +1,21 @@
-# Scalar-type tests: Boost.Multiprecision's float128 needs libquadmath (GCC's own library,
-# found by the compiler driver); without it nhdyn::quad falls back to the header-only
-# cpp_bin_float_quad (scalar/multiprecision.hpp).
+# The typed scalar suite, tests/test_scalar_types.cpp, as four executables
+# test_scalar_types_<group> (NHDYN_SCALAR_GROUP: 1 float/double/long double, 2 multiprecision,
+# 3 duals and AutoDiffScalar, 4 intervals), so that a parallel build compiles the groups side
+# by side: together they instantiate every algorithm for eleven scalar types.
+#
+# Boost.Multiprecision's float128 needs libquadmath (GCC's own library, found by the compiler
+# driver); without it nhdyn::quad falls back to the header-only cpp_bin_float_quad
+# (scalar/multiprecision.hpp).
 include(CheckCXXSourceCompiles)
 set(CMAKE_REQUIRED_LIBRARIES quadmath)
 check_cxx_source_compiles("#include <quadmath.h>
 int main() { __float128 x = 2; return (int)sqrtq(x); }" NHDYN_HAVE_QUADMATH)
 unset(CMAKE_REQUIRED_LIBRARIES)
-foreach(t test_scalar_types test_linearize test_bounds)
+foreach(group 1 2 3 4)
+  nhdyn_add_test(test_scalar_types_${group} ${CMAKE_CURRENT_SOURCE_DIR}/test_scalar_types.cpp)
+  target_compile_definitions(test_scalar_types_${group} PRIVATE NHDYN_SCALAR_GROUP=${group})
+endforeach()
+foreach(t test_scalar_types_2 test_linearize test_bounds)
   if(TARGET ${t})
     if(NHDYN_HAVE_QUADMATH)
       target_link_libraries(${t} PRIVATE quadmath)
@@ -15,9 +24,3 @@ foreach(t test_scalar_types test_linearize test_bounds)
     endif()
   endif()
 endforeach()
-# The typed suite instantiates every algorithm for ten scalar types: -O1 keeps its compile
-# time reasonable (interval soundness does not depend on the optimisation level: the
-# rounding policy never changes the FPU mode).
-if(TARGET test_scalar_types)
-  target_compile_options(test_scalar_types PRIVATE -O1)
-endif()

@@ -219,9 +219,10 @@ TEST_CASE("identities: rne(q, qd, 0) is the bias, M qdd + bias is rne, forward d
       CHECK(es_lib.eigenvalues().minCoeff() > 0);
       CHECK(w_eig(rel(es_lib.eigenvalues(), es.eigenvalues())) < tol);
       const double cond = double(es.eigenvalues().maxCoeff() / es.eigenvalues().minCoeff());
-      // Forward dynamics: its error is bounded by cond(M)·ε (backward stability of LDLᵀ).
-      CHECK(w_fd(rel(fd(q, qd, v), ld(qdd)) / cond) < 1e-14);
-      CHECK(rel(fd(q, qd, v), ld(qdd)) < 1e-13 * cond);
+      // Forward dynamics: its error is bounded by c·n·ε·cond(M) (backward stability of LDLᵀ,
+      // plus the rounding of v itself, also amplified by cond(M)). c·n ≈ 900 here; observed
+      // up to ≈ 110 (clang -O0, without contractions), 60–80 with g++ -O1…-O3.
+      CHECK(w_fd(rel(fd(q, qd, v), ld(qdd)) / cond) < 1e-13);
     }
   };
   check(nhdyn::presets::paper5_chain<double>(), 20);
