@@ -9,6 +9,13 @@ if(TARGET nhdyn_tool)
     COMMAND ${CMAKE_COMMAND} -DTOOL=$<TARGET_FILE:nhdyn_tool> -DSCENE=${CMAKE_CURRENT_SOURCE_DIR}/scenes/failing-gains.json
             -DRUN=failing-gains -DOUT=${CMAKE_CURRENT_BINARY_DIR}/simulate_cli_fail -DEXPECT_RC=1
             "-DEXPECT_TEXT=too many steps" -P ${_sim_check})
-  set_tests_properties(simulate_cli_paper_circle_succeeds simulate_cli_failing_run_exits_1_with_reason PROPERTIES
+  # The paper's whole experiment (circle + both 16-run studies, run in parallel): 33/33.
+  add_test(NAME simulate_cli_paper_33_of_33
+    COMMAND ${CMAKE_COMMAND} -DTOOL=$<TARGET_FILE:nhdyn_tool> -DSCENE=paper -DRUN=paper-noise-seed_16
+            -DOUT=${CMAKE_CURRENT_BINARY_DIR}/simulate_cli_paper -DEXPECT_RC=0
+            "-DEXPECT_TEXT=paper-factorial: 16/16 succeeded" "-DEXPECT_TEXT2=paper-noise: 16/16 succeeded"
+            -DEXPECT_SUCCESSES=33 -P ${_sim_check})
+  set_tests_properties(simulate_cli_paper_circle_succeeds simulate_cli_failing_run_exits_1_with_reason
+                       simulate_cli_paper_33_of_33 PROPERTIES
     ENVIRONMENT "NHDYN_SCENES_DIR=${PROJECT_SOURCE_DIR}/examples/scenes")
 endif()

@@ -104,3 +104,34 @@ TEST_CASE("controller: converges to a fixed target on the nominal plant") {
   REQUIRE(exact.success);
   CHECK(exact.rows(exact.rows.rows() - 1, 20) < 1e-6 * e0);
 }
+
+TEST_CASE("controller: at a singular B (arm pointing straight up) σ₃ = 0 is reported; damped B⁺ stays finite, λ = 0 throws") {
+  // With the arm vertical above the shoulder (q₄ = π/2, q₅ = 0) the tip lies on the yaw
+  // axis: neither turning nor any arm joint moves it sideways, so B = J_v S has rank 2.
+  const auto robot = presets::paper5<double>();
+  vecN<double, 5> q0;
+  q0 << -0.23710299623923958, 1.0, 3.141592653589793, 2.058145585963254, 1.2;
+  const vecN<double, 5> mask = (vecN<double, 5>() << 0, 0, 0, 1, 1).finished();
+  vecN<double, 5> q;
+  q << 0.2, -0.3, 0.4, 1.5707963267948966, 0.0;
+  const rac_controller damped(robot.chain, robot.constraint, rac_gains{}, q0, mask);
+  const Eigen::Vector3d sv = damped.task_singular_values(q);
+  CHECK(sv(2) < 1e-14 * sv(0));
+  // Independent: the tip's lateral direction z₃ = (0, cos q₃, sin q₃) is orthogonal to B's range.
+  const Eigen::Vector3d z3(0, std::cos(q(2)), std::sin(q(2)));
+  kinematics<double, 5> k(robot.chain);
+  const Eigen::Matrix<double, 3, 4> B = k.jacobian(q, 5).topRows<3>() * robot.constraint.S(q);
+  CHECK((z3.transpose() * B).norm() < 1e-14);
+  // Away from it σ₃ > 0 (the start configuration).
+  CHECK(damped.task_singular_values(q0)(2) > 1e-2);
+
+  const vecN<double, 4> eta(0.1, -0.2, 0.3, 0.1);
+  const auto ref = circle_reference{}(0.0);
+  const vec3<double> r = damped.task_point(q) + vec3<double>(0.01, 0.02, -0.01);
+  const vecN<double, 4> tau = damped(q, eta, r, ref);
+  CHECK(tau.allFinite());
+  rac_gains undamped;
+  undamped.lambda = 0;
+  const rac_controller c0(robot.chain, robot.constraint, undamped, q0, mask);
+  CHECK_THROWS_AS(c0(q, eta, r, ref), numerical_error);
+}

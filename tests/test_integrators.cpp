@@ -225,6 +225,25 @@ TEST_CASE("integrators: failures are reported with time, state and reason") {
     CHECK_THAT(r.failure->reason, Catch::Contains("singular"));
     CHECK(r.failure->t <= 0.25);
   }
+  SECTION("step size underflow: an explicit method on a stiff problem with a floor on the step") {
+    // y' = −10⁶ (y − cos t), y(0) = 1 (no transient: y ≈ cos t): dopri5 is stable only for
+    // h ≲ 3e-6, below the floor of 1e-4.
+    const auto stiff = [](const auto& t, const auto& x) {
+      using T = std::decay_t<decltype(t)>;
+      using std::cos;
+      return vecN<T, 1>(T(-1e6) * (x(0) - cos(t)));
+    };
+    nhdyn::integrator_options o{method::dopri5, 1e-3, 1e-8, 1e-8};
+    o.min_step = 1e-4;
+    const auto r = integrate<1>(stiff, vecN<double, 1>(1), 0.0, 1.0, o, none, ignore);
+    REQUIRE_FALSE(r.success());
+    CHECK_THAT(r.failure->reason, Catch::Contains("step size underflow"));
+    CHECK(r.failure->t < 1.0);
+    CHECK(r.failure->x.allFinite());
+    // The stiff method takes the same problem in stride with the same floor.
+    o.kind = method::rosenbrock4;
+    CHECK(integrate<1>(stiff, vecN<double, 1>(1), 0.0, 1.0, o, none, ignore).success());
+  }
   SECTION("too many steps") {
     nhdyn::integrator_options o{method::dopri5, 1e-3, 1e-12, 1e-12};
     o.max_steps = 50;

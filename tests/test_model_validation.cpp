@@ -210,3 +210,48 @@ TEST_CASE("validation: a link with zero mass but rotational inertia is legal and
     }
   }
 }
+
+TEST_CASE("presets: paper5's perturbation factors change the box they describe, as paper5.md defines") {
+  // Expected values written from paper5.md's rules, not from the preset's code: a length
+  // factor scales the DH parameter and the box edge along the same axis (platform height for
+  // d₃, link length for a₄, a₅), the centre of mass and the box inertia follow; a mass factor
+  // scales the link's mass and its inertia (same box, denser).
+  const auto box = [](double m, double ex, double ey, double ez) {
+    return Eigen::Vector3d(m * (ey * ey + ez * ez) / 12, m * (ex * ex + ez * ez) / 12, m * (ex * ex + ey * ey) / 12);
+  };
+  const auto diag = [](const nhdyn::mat3<double>& I) { return Eigen::Vector3d(I(0, 0), I(1, 1), I(2, 2)); };
+  const auto near = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return (a - b).cwiseAbs().maxCoeff() <= 1e-15 * std::max(1.0, b.cwiseAbs().maxCoeff());
+  };
+  for (const double f : {0.9, 1.1}) {
+    INFO("factor " << f);
+    nhdyn::presets::paper5_parameters<double> p;
+    p.d3_factor = f;
+    p.a4_factor = f;
+    p.a5_factor = f;
+    p.mass_factor[2] = f;
+    const auto c = nhdyn::presets::paper5_chain<double>(p);
+    const double d3 = 0.237 * f, a4 = 0.150 * f, a5 = 0.168 * f, m3 = 9.0 * f;
+    CHECK(c[2].d == Approx(d3).epsilon(1e-15));
+    CHECK(c[2].mass == Approx(m3).epsilon(1e-15));
+    CHECK(near(c[2].com, Eigen::Vector3d(0, -d3 / 2, 0)));
+    CHECK(near(diag(c[2].inertia), box(m3, 0.445, d3, 0.393)));
+    CHECK(c[3].a == Approx(a4).epsilon(1e-15));
+    CHECK(near(c[3].com, Eigen::Vector3d(-a4 / 2, 0, 0)));
+    CHECK(near(diag(c[3].inertia), box(0.1, a4, 0.05, 0.05)));
+    CHECK(c[4].a == Approx(a5).epsilon(1e-15));
+    CHECK(near(c[4].com, Eigen::Vector3d(-a5 / 2, 0, 0)));
+    CHECK(near(diag(c[4].inertia), box(0.1, a5, 0.05, 0.05)));
+    // The table's rounded figures at the nominal values (paper5.md, Table II).
+    if (f == 0.9) continue;
+    const auto n = nhdyn::presets::paper5_chain<double>();
+    CHECK(near(diag(n[2].inertia), Eigen::Vector3d(0.1579635, 0.2643555, 0.1906455)));
+    CHECK((diag(n[4].inertia) - Eigen::Vector3d(4.1666667e-5, 2.5603333e-4, 2.5603333e-4)).cwiseAbs().maxCoeff() < 1e-11);  // 8 digits
+  }
+  // Mass factors on the arm links scale mass and inertia together.
+  nhdyn::presets::paper5_parameters<double> p;
+  p.mass_factor[3] = 1.1;
+  const auto c = nhdyn::presets::paper5_chain<double>(p);
+  CHECK(c[3].mass == Approx(0.11).epsilon(1e-15));
+  CHECK(near(diag(c[3].inertia), box(0.11, 0.150, 0.05, 0.05)));
+}

@@ -11,6 +11,10 @@
 #include <nhdyn/scalar/interval.hpp>
 #include <nhdyn/scalar/multiprecision.hpp>
 
+#include <boost/math/constants/constants.hpp>
+
+#include "reference/lagrangian.hpp"
+
 namespace {
 
 using nhdyn::value_of;
@@ -248,6 +252,42 @@ TEMPLATE_TEST_CASE("scalars: A S = 0 for the differential drive, for every scala
     for (int j = 0; j < 4; ++j) CHECK(small<S>(AS(j), 1.0, 4 * eps<S>()));
   }
 }
+
+#if NHDYN_SCALAR_GROUP == 0 || NHDYN_SCALAR_GROUP == 2
+TEST_CASE("scalars: the 50-digit rne, the reference of this suite, agrees with the independent 50-digit Lagrangian") {
+  // Cross-check of the reference itself: tests/reference/lagrangian.hpp (M from link
+  // Jacobians, Christoffel symbols of ∂M/∂q, gravity from the potential energy; no algorithm
+  // shared with the library) evaluated in mp50. nhdyn takes a twist within 1e-15 of a
+  // multiple of π/2 as exact (detail/dh.hpp); the reference gets the same α to 50 digits.
+  using nhdyn::mp50;
+  const auto exact_twists = [](nhdyn_ref::model<mp50> m) {
+    const mp50 half_pi = boost::math::constants::half_pi<mp50>();
+    for (auto& b : m.bodies)
+      for (int k = -2; k <= 2; ++k)
+        if (abs(b.alpha - k * half_pi) < mp50(1e-15)) b.alpha = k * half_pi;
+    return m;
+  };
+  const auto check = [&](const auto& ch, const auto& q, const auto& qd, const auto& qdd) {
+    const auto c50 = ch.template cast<mp50>();
+    const auto ref = exact_twists(nhdyn_ref::from_chain<mp50>(ch));
+    const nhdyn_ref::vec<mp50> q50 = to<mp50>(q), qd50 = to<mp50>(qd), qdd50 = to<mp50>(qdd);
+    const nhdyn_ref::vec<mp50> tau_ref = nhdyn_ref::mass_matrix<mp50>(ref, q50) * qdd50 +
+                                         nhdyn_ref::coriolis<mp50>(ref, q50, qd50) + nhdyn_ref::gravity<mp50>(ref, q50);
+    const auto tau = nhdyn::rne(c50)(to<mp50>(q), to<mp50>(qd), to<mp50>(qdd));
+    mp50 err = 0, scale = 1;
+    for (int i = 0; i < tau.size(); ++i) {
+      err = std::max(err, mp50(abs(tau(i) - tau_ref(i))));
+      scale = std::max(scale, mp50(abs(tau_ref(i))));
+    }
+    INFO("chain " << ch.name() << ": relative difference " << static_cast<double>(err / scale));
+    CHECK(static_cast<double>(err / scale) < 1e-44);
+  };
+  const V5 q5(0.1, -0.2, 0.7, 0.4, -0.9), qd5(0.3, -0.1, 0.5, 1.2, -0.7), qdd5(0.2, 0.4, -0.3, 1.0, 0.5);
+  check(nhdyn::presets::paper5_chain<double>(), q5, qd5, qdd5);
+  const V6 q6(0.3, -0.8, 1.1, 0.2, -0.5, 0.9), qd6(0.5, -0.3, 0.8, -1.0, 0.4, 0.7), qdd6(-0.4, 0.9, 0.3, 0.6, -0.2, 1.1);
+  check(nhdyn::presets::puma560<double>(), q6, qd6, qdd6);
+}
+#endif
 
 #if NHDYN_SCALAR_GROUP == 0 || NHDYN_SCALAR_GROUP == 3
 TEST_CASE("scalars: the derivative parts of dual and autodiff identities vanish too") {

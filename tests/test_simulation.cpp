@@ -98,6 +98,26 @@ TEST_CASE("simulation: paper-circle succeeds with paper5.md's ≈3 mm tail error
   CHECK((a.rows - b.rows).cwiseAbs().maxCoeff() < 1e-3);
 }
 
+TEST_CASE("simulation: the stiff method with the closed loop's exact dual Jacobian follows dopri5 on paper-circle") {
+  // rosenbrock4 differentiates the whole closed loop (plant forward dynamics, controller,
+  // reference) on dual<double, 10> numbers; a wrong Jacobian would cost it its order and show
+  // up as a different trajectory. Both at tight tolerances over the start-up transient.
+  run_spec s;
+  s.duration = 1.5;
+  s.tail_from = 1.0;
+  s.tail_tolerance = 1;  // not the criterion under test
+  s.integrator = {method::dopri5, 1e-3, 1e-10, 1e-12};
+  const auto a = simulate(s);
+  s.integrator = {method::rosenbrock4, 1e-3, 1e-8, 1e-10};
+  const auto b = simulate(s);
+  REQUIRE(a.success);
+  REQUIRE(b.success);
+  REQUIRE(a.rows.rows() == b.rows.rows());
+  // q, η (columns 1…9) and r (14…16) agree to the tolerances' level.
+  CHECK((a.rows.middleCols(1, 9) - b.rows.middleCols(1, 9)).cwiseAbs().maxCoeff() < 1e-5);
+  CHECK((a.rows.middleCols(14, 3) - b.rows.middleCols(14, 3)).cwiseAbs().maxCoeff() < 1e-6);
+}
+
 TEST_CASE("simulation: under zero-order hold τ is constant between samples and changes at them") {
   run_spec s;
   s.duration = 0.2;

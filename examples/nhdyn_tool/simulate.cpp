@@ -182,7 +182,15 @@ int run(const std::vector<std::string>& args) {
     e["peak_tau"] = r.peak_tau;
     summary.push_back(e);
   }
-  std::ofstream(dir / "summary.json") << summary.dump(2) << '\n';
+  {
+    std::ofstream f(dir / "summary.json");
+    f << summary.dump(2) << '\n';
+    f.flush();
+    if (!f) {
+      std::cerr << "nhdyn simulate: cannot write " << (dir / "summary.json").string() << '\n';
+      return 1;
+    }
+  }
 
   std::size_t width = 4;
   for (const auto& r : results) width = std::max(width, r.name.size());

@@ -1,6 +1,7 @@
 # Runs TOOL simulate SCENE --out OUT --no-plots; checks the exit status (EXPECT_RC), that
-# stdout contains EXPECT_TEXT, that OUT/RUN.csv starts with the documented header and that
-# OUT/summary.json names the run.
+# stdout contains EXPECT_TEXT (and EXPECT_TEXT2 if given), that OUT/RUN.csv starts with the
+# documented header, that OUT/summary.json names the run and, if EXPECT_SUCCESSES is given,
+# that exactly that many runs in it succeeded.
 file(REMOVE_RECURSE ${OUT})
 execute_process(COMMAND ${TOOL} simulate ${SCENE} --out ${OUT} --no-plots
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -11,6 +12,12 @@ string(FIND "${out}" "${EXPECT_TEXT}" at)
 if(at EQUAL -1)
   message(FATAL_ERROR "stdout lacks '${EXPECT_TEXT}':\n${out}\n${err}")
 endif()
+if(DEFINED EXPECT_TEXT2)
+  string(FIND "${out}" "${EXPECT_TEXT2}" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "stdout lacks '${EXPECT_TEXT2}':\n${out}\n${err}")
+  endif()
+endif()
 file(STRINGS ${OUT}/${RUN}.csv header LIMIT_COUNT 1)
 if(NOT header STREQUAL "t,q1,q2,q3,q4,q5,eta1,eta2,eta3,eta4,tau1,tau2,tau3,tau4,r_x,r_y,r_z,rd_x,rd_y,rd_z,err")
   message(FATAL_ERROR "CSV header is '${header}'")
@@ -19,4 +26,13 @@ file(READ ${OUT}/summary.json summary)
 string(FIND "${summary}" "\"name\": \"${RUN}\"" at)
 if(at EQUAL -1)
   message(FATAL_ERROR "summary.json lacks run ${RUN}:\n${summary}")
+endif()
+if(DEFINED EXPECT_SUCCESSES)
+  string(REGEX MATCHALL "\"success\": true" ok "${summary}")
+  string(REGEX MATCHALL "\"success\": " all "${summary}")
+  list(LENGTH ok n_ok)
+  list(LENGTH all n_all)
+  if(NOT n_ok EQUAL EXPECT_SUCCESSES OR NOT n_all EQUAL EXPECT_SUCCESSES)
+    message(FATAL_ERROR "summary.json: ${n_ok} of ${n_all} runs succeeded, expected ${EXPECT_SUCCESSES} of ${EXPECT_SUCCESSES}:\n${out}")
+  endif()
 endif()

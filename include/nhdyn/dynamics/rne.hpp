@@ -213,11 +213,12 @@ class rne_fn : public stage_tag {
   const vec3<S>& gravity() const { return g_; }
 
   /// v = M q̈ + C q̇ + g (sizes n; q [rad or m], q̇, q̈ per joint). The result's scalar is
-  /// the common type of the model's and the state's.
+  /// the common type of the model's and of q's, q̇'s and q̈'s (a dual q̇ with a double q, say).
   template <class Q, class QD, class QDD>
+    requires scalar<typename Q::Scalar> && scalar<typename QD::Scalar> && scalar<typename QDD::Scalar>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
                   const Eigen::MatrixBase<QDD>& qdd) const {
-    using T = promote_t<S, typename Q::Scalar>;
+    using T = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>, typename QDD::Scalar>;
     detail::check_size(q, n_, "q");
     detail::check_size(qd, n_, "qd");
     detail::check_size(qdd, n_, "qdd");

@@ -386,7 +386,7 @@ model<S> preset(std::string_view name) {
   if (name == "puma560")
     return {presets::puma560<S>().dynamic_size(), std::nullopt,
             "Unimation Puma 560, standard DH, rigid-body parameters of P. Corke's Robotics Toolbox "
-            "mdl_puma560.m (Armstrong, Khatib & Burdick 1986); no motor inertia, gearing or friction; "
+            "mdl_puma560.m (parameters of 8/95: Corke & Armstrong-Helouvry, ICRA 1994); no motor inertia, gearing or friction; "
             "links 1 and 3 violate the triangle inequality as published"};
   std::string known;
   for (const auto& n : preset_names()) known += (known.empty() ? "" : ", ") + n;

@@ -107,8 +107,9 @@ struct validation {
   bool triangle_inequality = true;
 };
 
-/// A serial chain of N joints (N = nhdyn::dynamic for a run-time size).
-template <class S, int N = dynamic>
+/// A serial chain of N joints (N = nhdyn::dynamic for a run-time size), in the number type S
+/// (any nhdyn::scalar: float, double, multiprecision, duals, intervals…).
+template <scalar S, int N = dynamic>
 class chain {
  public:
   using scalar_type = S;

@@ -8,8 +8,10 @@
 ///   factor scales that link's inertia with it; a length factor scales the DH parameter and
 ///   the box edge along it, and the centre of mass and inertia follow).
 /// - `puma560`: the Unimation Puma 560 in standard DH with the rigid-body parameters of
-///   P. Corke's Robotics Toolbox (`mdl_puma560.m`, from Armstrong, Khatib & Burdick 1986),
-///   no motor inertia, gearing or friction. As published, links 1 and 3 violate the
+///   P. Corke's Robotics Toolbox for MATLAB (`models/mdl_puma560.m`, "params of 8/95"; its
+///   reference: P. Corke and B. Armstrong-Hélouvry, "A search for consensus among model
+///   parameters reported for the PUMA 560 robot", ICRA 1994, pp. 1608–1613), without the
+///   motor inertia Jm, gear ratios G and friction B, Tc that file adds. As published, links 1 and 3 violate the
 ///   triangle inequality of principal moments, so this preset is built with
 ///   `validation.triangle_inequality = false` (see model/chain.hpp).
 #include <numbers>

@@ -5,8 +5,8 @@
 /// - `nhdyn::mp50`  — cpp_bin_float<50>: 50 decimal digits, binary, header-only.
 /// - `nhdyn::dec50` — cpp_dec_float<50>: 50 decimal digits, decimal, header-only.
 /// - `nhdyn::quad`  — IEEE binary128 (113-bit significand): Boost's `float128` over GCC's
-///   __float128 when the compiler has it (link with -lquadmath; the CMake target
-///   `nhdyn::quadmath` of tests/examples does it), else the header-only cpp_bin_float_quad.
+///   __float128 when the compiler has it (link with -lquadmath, as tests/scalar_types.cmake
+///   does), else the header-only cpp_bin_float_quad (define NHDYN_NO_FLOAT128).
 ///
 /// Expression templates are off (`et_off`): Eigen and nhdyn's generic code store every
 /// intermediate in the scalar type, and expression templates would only add copies.

@@ -44,10 +44,27 @@ bool is_finite_scalar(const S& x) {
   return scalar_traits<S>::is_finite(x);
 }
 
-/// What a number type must provide: field arithmetic, construction from double, and the
-/// customisation point above.
+namespace detail::scalar_math {
+// sin, cos, sqrt as the algorithms call them: `using std::sin; sin(x)` — std's for the
+// built-in types, the type's own (found by argument-dependent lookup) for every other.
+using std::cos;
+using std::sin;
+using std::sqrt;
 template <class S>
-concept scalar = std::copyable<S> && std::constructible_from<S, double> &&
+concept has_math = requires(const S& a) {
+                     { sin(a) } -> std::convertible_to<S>;
+                     { cos(a) } -> std::convertible_to<S>;
+                     { sqrt(a) } -> std::convertible_to<S>;
+                   };
+}  // namespace detail::scalar_math
+
+/// What a number type must provide: field arithmetic, construction from double, sin, cos
+/// and sqrt (in std or by argument-dependent lookup), and the customisation point above
+/// (its value, exact zero and finiteness). Integers are not scalars: the algorithms divide.
+/// The model types (chain, link) and the state arguments of the algorithms require it.
+template <class S>
+concept scalar = std::copyable<S> && std::constructible_from<S, double> && !std::is_integral_v<S> &&
+                 detail::scalar_math::has_math<S> &&
                  requires(S a, S b) {
                    { a + b } -> std::convertible_to<S>;
                    { a - b } -> std::convertible_to<S>;
@@ -55,6 +72,8 @@ concept scalar = std::copyable<S> && std::constructible_from<S, double> &&
                    { a / b } -> std::convertible_to<S>;
                    { -a } -> std::convertible_to<S>;
                    { value_of(a) } -> std::convertible_to<double>;
+                   { is_exact_zero(a) } -> std::convertible_to<bool>;
+                   { is_finite_scalar(a) } -> std::convertible_to<bool>;
                  };
 
 /// The scalar of a computation that mixes a model scalar M with a state scalar X

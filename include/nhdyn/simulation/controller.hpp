@@ -158,6 +158,15 @@ class rac_controller {
     return kin_.point(q, link_);
   }
 
+  /// The singular values of B(q) = J_v(q) S(q) (eq. 29), largest first, in double: how far
+  /// the task is from a singular configuration (σ₃ → 0 there: some task velocity cannot be
+  /// produced). With λ > 0 the damped B⁺ keeps its gain σ/(σ² + λ²) ≤ 1/(2λ) there; with
+  /// λ = 0 the controller throws numerical_error at a singular B instead of dividing by 0.
+  Eigen::Vector3d task_singular_values(const vecN<double, N>& q) const {
+    const Eigen::Matrix<double, 3, M> B = kin_.jacobian(q, link_).template topRows<3>() * c_.S(q);
+    return Eigen::JacobiSVD<Eigen::Matrix<double, 3, M>>(B).singularValues().template head<3>();
+  }
+
  private:
   C c_;
   kinematics<S, N> kin_;

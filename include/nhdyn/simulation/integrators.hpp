@@ -10,7 +10,8 @@
 ///   atol + rtol·|x|, with its 4th-order continuous extension for output between steps
 ///   (odeint `runge_kutta_dopri5` + `dense_output_runge_kutta`).
 /// - `method::rosenbrock4`: the linearly-implicit (stiff) Rosenbrock method of order 4 of
-///   odeint's `rosenbrock4` (Shampine's coefficients, with its step controller and dense
+///   odeint's `rosenbrock4` (its coefficient set γ = 0.25, a₂₁ = 1.544, c₂ = 0.386 — the one
+///   Numerical Recipes 3rd ed. uses in StepperRoss —, with its step controller and dense
 ///   output), run on Eigen storage (see detail::rosenbrock4_step for why). Its Jacobians
 ///   ∂f/∂x and ∂f/∂t are exact: f is evaluated once on nhdyn::dual<double, D + 1>
 ///   numbers, so f must be generic over its scalar; D must be known at compile time.
@@ -65,7 +66,7 @@ struct integrator_options {
   method kind = method::dopri5;
   double step = 1e-3;          ///< rk4: the (largest) step; adaptive: the first step tried
   double rtol = 1e-6, atol = 1e-8;
-  long max_steps = 10'000'000;  ///< accepted steps over one integrate() call
+  long max_steps = 10'000'000;  ///< accepted steps over one integrate() call (simulate: over the run)
   double min_step = 1e-12;     ///< smallest admissible adaptive step, relative to max(1, |t|)
 };
 
@@ -140,8 +141,8 @@ void exact_jacobian(F& f, double t, const vecN<double, D>& x, Eigen::Matrix<doub
   }
 }
 
-/// One step of odeint's rosenbrock4 (coefficients default_rosenbrock_coefficients, Kaps–
-/// Rentrop/Shampine, order 4 with an order-3 error estimate and a continuous extension),
+/// One step of odeint's rosenbrock4 (coefficients default_rosenbrock_coefficients: 4 stages,
+/// order 4 with an order-3 error estimate and a continuous extension),
 /// on Eigen storage: Boost 1.74's uBLAS, which odeint's own rosenbrock4 stores its state
 /// in, does not compile as C++20 (it calls std::allocator::construct, removed in C++20).
 /// The algorithm, coefficients and controller below are odeint's, line for line, with one

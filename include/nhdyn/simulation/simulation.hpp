@@ -188,9 +188,13 @@ inline run_result simulate(const run_spec& s) {
       const double slack = 1e-9 / s.sample_rate;
       while (hi < t_out.size() && (t_out[hi] < tk1 - slack || (k + 1 == n_samples && t_out[hi] <= tk1 + slack))) ++hi;
       std::span<const double> piece(t_out.data() + lo, hi - lo);
-      auto r = integrate<9>(f, x, tk, tk1, s.integrator, piece,
+      integrator_options opts = s.integrator;  // the step budget is the run's, not each piece's
+      opts.max_steps = s.integrator.max_steps - res.steps;
+      auto r = integrate<9>(f, x, tk, tk1, opts, piece,
                             [&](int i, const vecN<double, 9>& xi) { observe(int(lo) + i, xi); }, &dt);
       res.steps += r.steps;
+      if (r.failure && r.failure->reason.rfind("too many steps", 0) == 0)
+        r.failure->reason = "too many steps (more than " + std::to_string(s.integrator.max_steps) + " in the run)";
       failure = r.failure;
       x = r.x;
     }
