@@ -190,6 +190,17 @@ TEST_CASE("extremes: a heading of 1e6 rad costs nothing beyond the input's own r
     auto ch = spatial_chain<S, T>(3, [](int) { return 2.0; }, [](int) { return 0.5; });
     return vec<T>(rne(ch)(rv<S, T>({1e6, -3e5 - 0.25, 0.4}), rv<S, T>({1, -2, 0.5}), rv<S, T>({0.5, 1, -1})));
   };
+  // The same for the differential drive's heading ψ = −q₃ + forward offset (an offset of
+  // 0.3 rad: the platform's forward axis turned from the DH x axis).
+  const auto drive_offset = []<class S, class T>() {
+    const auto ch = paper5_in<S, T>();
+    const differential_drive<T, 5> c(5, 0, 1, 2, r<S, T>(0.3), T(-1));
+    return vec<T>(inverse_dynamics(ch, c)(rv<S, T>({1e3, -2e3, 1e6 + 0.1, 0.5, -1.1}), rv<S, T>({1, 0.5, -1, 2}),
+                                          rv<S, T>({0.1, -0.2, 0.3, 0.4})));
+  };
+  measure<float>("paper5 id, q3 = 1e6 rad, heading offset 0.3 rad", drive_offset, 100 * u<float>());
+  measure<double>("paper5 id, q3 = 1e6 rad, heading offset 0.3 rad", drive_offset, 100 * u<double>());
+  measure<long double>("paper5 id, q3 = 1e6 rad, heading offset 0.3 rad", drive_offset, 100 * u<long double>());
   measure<float>("3-joint chain id, q = 1e6 with θ⁰ ≠ 0", offset, 1000 * u<float>());
   measure<double>("3-joint chain id, q = 1e6 with θ⁰ ≠ 0", offset, 1000 * u<double>());
   measure<long double>("3-joint chain id, q = 1e6 with θ⁰ ≠ 0", offset, 1000 * u<long double>());

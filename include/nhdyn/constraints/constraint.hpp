@@ -125,9 +125,16 @@ struct differential_drive {
   /// A, S, Ṡ depend on the heading joint only.
   bool depends_on(int j) const { return j == heading; }
 
+  /// cos ψ, sin ψ of the heading ψ = heading_sign·q_h + forward_offset, as the exact sum: for
+  /// a floating-point T the rounding error of the sum is recovered (TwoSum) and (cos, sin) are
+  /// turned by it, as for a joint's θ⁰ + q (detail/dh.hpp); with offset 0 nothing is done.
   template <class T>
-  T psi(const T& qh) const {
-    return T(heading_sign * qh + forward_offset);  // mixed: the constants stay Sc
+  detail::sin_cos<T> sincos_psi(const T& qh) const {
+    const T a = T(heading_sign * qh), b = T(forward_offset);  // heading_sign = ±1: a is exact
+    const T sum = a + b;
+    auto p = detail::sincos_of(sum);
+    detail::correct_angle_sum(a, b, sum, p.c, p.s);
+    return p;
   }
 
   template <class Q>
@@ -135,7 +142,7 @@ struct differential_drive {
     using T = promote_t<Sc, typename Q::Scalar>;
     using std::cos;
     using std::sin;
-    const auto p = detail::sincos_of(psi(T(q(heading))));
+    const auto p = sincos_psi(T(q(heading)));
     matrix<T, k_at_compile_time, N> a = matrix<T, k_at_compile_time, N>::Zero(1, n);
     a(0, x) = -p.s;
     a(0, y) = p.c;
@@ -174,7 +181,7 @@ struct differential_drive {
     int c = 0;
     for (int j = 0; j < n; ++j) {
       if (j == lo) {
-        const auto p = detail::sincos_of(psi(T(q(heading))));
+        const auto p = sincos_psi(T(q(heading)));
         const T v = T(eta(c++));
         qd(x) = p.c * v;
         qd(y) = p.s * v;
@@ -189,7 +196,7 @@ struct differential_drive {
   template <class Q, class V>
   auto A_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
     using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename V::Scalar>;
-    const auto p = detail::sincos_of(psi(T(q(heading))));
+    const auto p = sincos_psi(T(q(heading)));
     vecN<T, k_at_compile_time> out(1);
     out(0) = p.c * T(v(y)) - p.s * T(v(x));
     return out;
@@ -205,7 +212,7 @@ struct differential_drive {
     int c = 0;
     for (int j = 0; j < n; ++j) {
       if (j == lo) {
-        const auto p = detail::sincos_of(psi(T(q(heading))));
+        const auto p = sincos_psi(T(q(heading)));
         out(c++) = p.c * T(v(x)) + p.s * T(v(y));
       } else if (j != hi) {
         out(c++) = T(v(j));
@@ -217,7 +224,7 @@ struct differential_drive {
   /// projection of a temporary v allocates nothing. Sᵀv's entry c reads v's entries ≥ c only.
   template <class Q, class T>
   auto St_times_in_place(const Eigen::MatrixBase<Q>& q, vecN<T, N>&& v) const {
-    return St_times_in_place(q, std::move(v), detail::sincos_of(psi(T(q(heading)))));
+    return St_times_in_place(q, std::move(v), sincos_psi(T(q(heading))));
   }
   /// The same with sin/cos of ψ already known (the memo of lift_into).
   template <class Q, class T>
@@ -264,7 +271,7 @@ struct differential_drive {
       } else if (j == lo) {
         ++c;
       }
-    const auto p = detail::sincos_of(psi(T(q(heading))));
+    const auto p = sincos_psi(T(q(heading)));
     const T v = T(eta(v_slot())), vd = T(eta_dot(v_slot()));
     const T wv = T(heading_sign * qd(heading)) * v;  // ψ̇ v
     qd(x) = p.c * v;
@@ -281,7 +288,7 @@ struct differential_drive {
     using std::cos;
     using std::sin;
     vecN<T, N> out = vecN<T, N>::Zero(n);
-    const auto p = detail::sincos_of(psi(T(q(heading))));
+    const auto p = sincos_psi(T(q(heading)));
     const T pd = T(heading_sign) * T(qd(heading));
     const T v = T(eta(v_slot()));
     out(x) = -p.s * pd * v;
