@@ -149,6 +149,56 @@ TEST_CASE("differential_drive: fixed and run-time sizes agree; the paper5 preset
   REQUIRE(Mat(fixed.A(q)) == Mat(preset.A(q)));
 }
 
+TEST_CASE("inverse_dynamics, run-time sized: the stack-scratch call is project ∘ rne ∘ lift, bit for bit") {
+  // inverse_dynamics over a run-time-sized chain runs (q, η, η̇) on stack scratch
+  // (constraints/stages.hpp, scratch_inverse_dynamics); the same stages composed by hand,
+  // which go through heap vectors, must give the identical numbers.
+  const auto p5 = nhdyn::presets::paper5_chain<double>();
+  std::vector<nhdyn::link<double>> links;
+  for (int i = 0; i < 300; ++i) links.push_back(p5[i < 3 ? i : 3 + (i % 2)]);  // beyond the 256-entry scratch
+  const nhdyn::chain<double> long_chain(links, p5.gravity(), "paper5 base, 297-joint arm");
+  rng R;
+  for (const auto& ch : {p5.dynamic_size(), long_chain}) {
+    const int n = ch.dof();
+    for (const auto& c : {nhdyn::differential_drive<double>(n, 0, 1, 2, 0.0, -1.0),
+                          nhdyn::differential_drive<double>(n, 1, 0, 2, 0.3, 1.0)}) {
+      for (const nhdyn::rne_options o : {nhdyn::rne_options{}, nhdyn::rne_options{false, true}, nhdyn::rne_options{true, false}}) {
+        const auto id = nhdyn::inverse_dynamics(ch, c, o);
+        const auto by_hand = nhdyn::lift(c) | nhdyn::rne(ch, o) | nhdyn::project(c);
+        for (int k = 0; k < 5; ++k) {
+          const Vec q = R.vec(n, 3.0), eta = R.vec(n - 1, 2.0), etad = R.vec(n - 1, 2.0);
+          const Vec tau = id(q, eta, etad);
+          REQUIRE(tau.size() == n - 1);
+          REQUIRE(tau == Vec(by_hand(q, eta, etad)));
+          REQUIRE(tau == Vec(nhdyn::project(c)(nhdyn::rne(ch, o)(nhdyn::lift(c)(q, eta, etad)))));
+          REQUIRE(tau == Vec(id(nhdyn::reduced_state<double>{q, eta, etad})));
+          // Expressions as arguments, and a state of another scalar (a dual η̇).
+          REQUIRE(tau == Vec(id(q.head(n), 1.0 * eta, etad.segment(0, n - 1))));
+          using D = nhdyn::dual<double, 1>;
+          Eigen::Matrix<D, Eigen::Dynamic, 1> etad_d = etad.cast<D>();
+          etad_d(n - 2).derivative(0) = 1.0;  // d/dη̇_last: a column of M_η
+          const auto tau_d = id(q, eta, etad_d);
+          const auto tau_d_hand = by_hand(q, eta, etad_d);
+          for (int i = 0; i < n - 1; ++i) {
+            REQUIRE(tau_d(i).value() == tau_d_hand(i).value());
+            REQUIRE(tau_d(i).derivative(0) == tau_d_hand(i).derivative(0));
+          }
+        }
+      }
+      // Its errors are the composition's.
+      const Vec q = R.vec(n), eta = R.vec(n - 1);
+      Vec bad = eta;
+      bad(n - 2) = std::numeric_limits<double>::quiet_NaN();
+      CHECK_THROWS_WITH(nhdyn::inverse_dynamics(ch, c)(q, eta, bad), Catch::Contains("eta_dot"));
+      CHECK_THROWS_WITH(nhdyn::inverse_dynamics(ch, c)(q, bad, eta), Catch::Contains("eta"));
+      CHECK_THROWS_WITH(nhdyn::inverse_dynamics(ch, c)(q, Vec(eta.head(n - 2)), eta), Catch::Contains("eta has"));
+      CHECK_THROWS_WITH(nhdyn::inverse_dynamics(ch, c)(Vec(q.head(n - 1)), eta, eta), Catch::Contains("q has"));
+      const Vec huge = Vec::Constant(n - 1, 1e300);
+      CHECK_THROWS_AS(nhdyn::inverse_dynamics(ch, c)(q, huge, huge), nhdyn::numerical_error);
+    }
+  }
+}
+
 TEST_CASE("differential_drive: bad parameters are rejected with a clear error") {
   using dd = nhdyn::differential_drive<double>;
   const auto msg = [](auto f) {

@@ -230,8 +230,8 @@ struct differential_drive {
   template <class Q, class T>
   vecN<T, m_at_compile_time> St_times_in_place(const Eigen::MatrixBase<Q>&, vecN<T, N>&& v,
                                                const detail::sin_cos<T>& p) const {
-    const int lo = std::min(x, y), hi = std::max(x, y);
     if constexpr (N == dynamic) {
+      const int lo = std::min(x, y), hi = std::max(x, y);
       int c = 0;
       for (int j = 0; j < n; ++j) {
         if (j == lo)
@@ -244,24 +244,33 @@ struct differential_drive {
     } else {
       // Fixed size: written straight into the (elided) result; compacting v and copying its
       // head would read back just-written scalars as a vector (a store-forwarding stall).
-      vecN<T, m_at_compile_time> out;
-      int c = 0;
-      for (int j = 0; j < n; ++j) {
-        if (j == lo)
-          out(c++) = p.c * v(x) + p.s * v(y);
-        else if (j != hi)
-          out(c++) = v(j);
-      }
-      return out;
+      return St_times(v, p);
     }
+  }
+  /// Sᵀv into a new vector of m entries, with sin/cos of ψ known (v: any Eigen vector of n).
+  template <class V, class T>
+  vecN<T, m_at_compile_time> St_times(const Eigen::MatrixBase<V>& v, const detail::sin_cos<T>& p) const {
+    const int lo = std::min(x, y), hi = std::max(x, y);
+    vecN<T, m_at_compile_time> out;
+    out.resize(n - 1);
+    int c = 0;
+    for (int j = 0; j < n; ++j) {
+      if (j == lo)
+        out(c++) = p.c * v(x) + p.s * v(y);
+      else if (j != hi)
+        out(c++) = v(j);
+    }
+    return out;
   }
   /// (q̇, q̈) = (S η, S η̇ + Ṡ η) in one pass and one sin/cos of ψ, written into qd and qdd
   /// (n entries each): the lift's work (constraints/stages.hpp uses it when a constraint has
   /// it). Returns sin/cos of ψ, which rides along with ξ as a memo for the projection
-  /// (St_times_in_place).
-  template <class Q, class E, class ED, class T>
+  /// (St_times_in_place). qd and qdd: any writable Eigen vectors of n entries of one scalar.
+  template <class Q, class E, class ED, class QDo, class QDDo, class T = typename QDo::Scalar>
+    requires std::is_same_v<T, typename QDDo::Scalar>
   detail::sin_cos<T> lift_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
-                               const Eigen::MatrixBase<ED>& eta_dot, vecN<T, N>& qd, vecN<T, N>& qdd) const {
+                               const Eigen::MatrixBase<ED>& eta_dot, Eigen::MatrixBase<QDo>& qd,
+                               Eigen::MatrixBase<QDDo>& qdd) const {
     const int lo = std::min(x, y), hi = std::max(x, y);
     for (int j = 0, c = 0; j < n; ++j)
       if (j != lo && j != hi) {

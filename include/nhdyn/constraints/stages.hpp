@@ -10,7 +10,8 @@
 ///
 /// (`inverse_dynamics` adds a resize of ξ between lift and rne only when the constraint
 /// and the chain are sized differently, e.g. a run-time-sized user constraint on a
-/// fixed-size chain; the numbers are the same.)
+/// fixed-size chain; and, run-time sized, it keeps ξ and v in stack scratch rather than heap
+/// vectors (detail::scratch_inverse_dynamics). The numbers are the same.)
 ///
 /// and the constraint forces λ = (A Aᵀ)⁻¹ A (v − E τ), which do no work (q̇ᵀAᵀλ = 0).
 #include "../detail/ldlt.hpp"
@@ -245,9 +246,77 @@ auto nh_pipeline(const chain<S, N>& ch, const C& c, rne_options o, Out out) {
 }
 }  // namespace detail
 
+namespace detail {
+/// Whether inverse_dynamics over a run-time-sized chain of model scalar S can take the
+/// call (q, η, η̇) on stack scratch: a constraint that lifts into given storage (lift_into),
+/// projects with the lift's memo (St_times) and has SᵀS = I and no E, and a state whose
+/// scalar T the model's promotes to itself (double on double, dual or interval on double).
+template <class S, class C, class Q, class E, class ED>
+constexpr bool fusable_inverse_dynamics() {
+  constexpr auto is_vec = []<class X>() { return std::is_base_of_v<Eigen::MatrixBase<X>, X>; };
+  if constexpr (!(is_vec.template operator()<Q>() && is_vec.template operator()<E>() && is_vec.template operator()<ED>())) {
+    return false;
+  } else {
+    using T = promote_t<promote_t<promote_t<typename constraint_scalar<C>::type, typename Q::Scalar>, typename E::Scalar>,
+                        typename ED::Scalar>;
+    using Mp = Eigen::Map<vecN<T, dynamic>>;
+    return std::is_same_v<promote_t<S, T>, T> && C::orthonormal_S && !requires(const C& c, const Q& q) { c.E(q); } &&
+           requires(const C& c, const Q& q, const E& e, const ED& ed, Mp& m) { c.St_times(m, c.lift_into(q, e, ed, m, m)); };
+  }
+}
+
+/// inverse_dynamics over a run-time-sized chain: the composition project ∘ rne ∘ lift itself
+/// (it derives from it: the same stages, and every call form the composition has), except
+/// that the call (q, η, η̇), where the constraint allows (fusable_inverse_dynamics), runs
+/// the same three stages with ξ's q̇, q̈ and v in stack scratch instead of three heap
+/// vectors: lift_into writes q̇ and q̈, rne overwrites q̈ with v, St_times forms τ with the
+/// lift's sin/cos of the heading. Only τ is allocated, as a run-time-sized rne allocates
+/// only v. The numbers are the composition's, bit for bit (tests/test_constraints.cpp).
+template <class Composed, class S, class C>
+struct scratch_inverse_dynamics : Composed {
+  explicit scratch_inverse_dynamics(Composed c) : Composed(std::move(c)) {}
+
+  template <class... X>
+  decltype(auto) operator()(X&&... x) const {
+    if constexpr (sizeof...(X) == 3) {
+      if constexpr (fusable_inverse_dynamics<S, C, std::remove_cvref_t<X>...>()) return on_scratch(x...);
+      else return Composed::operator()(std::forward<X>(x)...);
+    } else {
+      return Composed::operator()(std::forward<X>(x)...);
+    }
+  }
+
+ private:
+  template <class Q, class E, class ED>
+  auto on_scratch(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
+                  const Eigen::MatrixBase<ED>& eta_dot) const {
+    const C& c = this->f.constraint();  // project
+    const auto& r = this->g.f;          // rne (this->g.g is the lift)
+    using T = promote_t<promote_t<promote_t<typename constraint_scalar<C>::type, typename Q::Scalar>, typename E::Scalar>,
+                        typename ED::Scalar>;
+    check_size(q, c.dof(), "q");  // the lift's checks, in its order
+    check_size(eta, c.m(), "eta");
+    check_size(eta_dot, c.m(), "eta_dot");
+    check_finite(q, "q");
+    check_finite(eta, "eta");
+    check_finite(eta_dot, "eta_dot");
+    const int n = c.dof();
+    small_buffer<T, dynamic, 256> qd_store(n), v_store(n);  // beyond 256 joints, on the heap
+    Eigen::Map<vecN<T, dynamic>> qd(qd_store.data(), n), v(v_store.data(), n);
+    const auto memo = c.lift_into(q, eta, eta_dot, qd, v);  // q̈ into v's storage
+    r.overwrite_qdd(q, qd, v);                               // v over q̈
+    return c.St_times(v, memo);
+  }
+};
+}  // namespace detail
+
 template <class S, int N, class C>
 auto inverse_dynamics(const chain<S, N>& ch, const C& c, rne_options o = {}) {
-  return detail::nh_pipeline(ch, c, o, project(c));
+  auto id = detail::nh_pipeline(ch, c, o, project(c));
+  if constexpr (N == dynamic && C::n_at_compile_time == dynamic)
+    return detail::scratch_inverse_dynamics<decltype(id), S, C>(std::move(id));
+  else
+    return id;
 }
 
 /// As inverse_dynamics, returning (τ, λ).

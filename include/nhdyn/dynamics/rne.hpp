@@ -36,10 +36,10 @@ struct rne_scratch {
 /// The recursion. Gravity and Velocity are compile-time so that a call that needs
 /// neither pays for neither. Written on plain scalars (detail::v3): this is the hot loop
 /// of the library, and the benchmark (docs/performance.md) chose this form.
-/// The n results go to `tau` (already of size n). `tau` may be the storage of `qdd`: q̈_i is
-/// read only in the forward pass, τ_i written only in the backward pass.
-template <bool Gravity, bool Velocity, class T, int N, class Links, class Q, class QD, class QDD>
-void rne_kernel(const Links& L, const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd, vecN<T, N>& tau) {
+/// The n results go to `tau` (any writable vector of T, already of size n). `tau` may be the
+/// storage of `qdd`: q̈_i is read only in the forward pass, τ_i written only in the backward pass.
+template <bool Gravity, bool Velocity, class T, int N, class Links, class Q, class QD, class QDD, class Tau>
+void rne_kernel(const Links& L, const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd, Tau& tau) {
   const int n = static_cast<int>(q.size());
   small_buffer<rne_scratch<T>, N> ws(n);
   small_buffer<T, N> cs(n), sn(n);  // cos θ_i, sin θ_i
@@ -262,6 +262,16 @@ class rne_fn : public stage_tag {
     }
   }
 
+  /// v = rne(q, q̇, q̈) written over q̈ (`qdd_then_v`: any writable Eigen vector of the
+  /// result's scalar, e.g. a map of stack scratch), checked as the pipeline form. What the
+  /// run-time-sized inverse_dynamics calls to stay as allocation-free as the fixed-size one.
+  template <class Q, class QD, class V>
+    requires std::is_same_v<typename V::Scalar, promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>>
+  void overwrite_qdd(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
+                     Eigen::MatrixBase<V>& qdd_then_v) const {
+    run_checked(q.derived(), qd.derived(), qdd_then_v.derived(), qdd_then_v.derived());
+  }
+
   /// The same algorithm with other options.
   rne_fn with(rne_options o) const {
     rne_fn r = *this;
@@ -281,8 +291,8 @@ class rne_fn : public stage_tag {
   /// so a non-finite result names q or q̇ when they are the cause, and otherwise says "q̈ or
   /// overflow". Not checking q̈ before is measurable (4 ns of a 115 ns paper5 call); inside
   /// inverse_dynamics, lift has checked η̇ already.
-  template <class X>
-  void run_checked(const vecN<X, N>& q, const vecN<X, N>& qd, const vecN<X, N>& qdd, vecN<X, N>& v) const {
+  template <class Qx, class QDx, class QDDx, class V>
+  void run_checked(const Qx& q, const QDx& qd, const QDDx& qdd, V& v) const {
     detail::check_size(q, n_, "q");
     detail::check_size(qd, n_, "qd");
     detail::check_size(qdd, n_, "qdd");
@@ -295,8 +305,9 @@ class rne_fn : public stage_tag {
                               " is not finite: qdd has a non-finite entry, or the computation overflowed");
       }
   }
-  template <class Q, class QD, class QDD, class T>
-  void run(const Q& q, const QD& qd, const QDD& qdd, vecN<T, N>& v) const {
+  template <class Q, class QD, class QDD, class V>
+  void run(const Q& q, const QD& qd, const QDD& qdd, V& v) const {
+    using T = typename V::Scalar;
     const vec3<T> g = g_.template cast<T>();
     if (opt_.gravity) {
       opt_.velocity ? detail::rne_kernel<true, true, T, N>(links_, g, q, qd, qdd, v)
