@@ -1,18 +1,23 @@
 #!/usr/bin/env bash
-# Builds and runs nhdyn's benchmarks, writes docs/performance.json, and regenerates the tables
-# of docs/performance.md and the plot docs/performance_scaling.png from it.
+# Builds and runs nhdyn's benchmarks, writes docs/performance.json (nhdyn_bench) and
+# docs/performance-scalar.json (nhdyn_bench_scalar), and regenerates the tables of
+# docs/performance.md and the plot docs/performance_scaling.png from them.
 #
-#   scripts/bench.sh                       # 5 repetitions, medians
-#   NHDYN_BENCH_REPS=9 scripts/bench.sh    # more repetitions
+#   scripts/bench.sh                       # 9 repetitions in random interleaved order, medians
+#   NHDYN_BENCH_REPS=15 scripts/bench.sh   # more repetitions
 #   NHDYN_BENCH_FILTER='^rne/' scripts/bench.sh --no-docs   # a subset, JSON only
 #
-# Environment: NHDYN_BENCH_BUILD (build dir, default build-bench), NHDYN_BENCH_REPS (5),
+# Environment: NHDYN_BENCH_BUILD (build dir, default build-bench), NHDYN_BENCH_REPS (9),
 # NHDYN_BENCH_MIN_TIME (seconds per repetition, 0.1), NHDYN_BENCH_FILTER (regex, all),
+# NHDYN_BENCH_SCALAR (1: also the scalar-type benchmarks; 0: skip them),
 # CXX (compiler of a fresh build directory).
+# The repetitions of all cases run interleaved in random order
+# (--benchmark_enable_random_interleaving): on a shared machine whose speed drifts, the two
+# sides of a ratio then sample the same drift instead of different minutes.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${NHDYN_BENCH_BUILD:-$root/build-bench}"
-reps="${NHDYN_BENCH_REPS:-5}"
+reps="${NHDYN_BENCH_REPS:-9}"
 min_time="${NHDYN_BENCH_MIN_TIME:-0.1}"
 filter="${NHDYN_BENCH_FILTER:-.}"
 docs=1
@@ -22,11 +27,13 @@ docs=1
 # CXX, if set, picks the compiler of a fresh build directory (CMake reads it at first configure).
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release \
   -DNHDYN_BUILD_BENCH=ON -DNHDYN_BUILD_TESTS=OFF -DNHDYN_BUILD_EXAMPLES=OFF >/dev/null
-make -C "$build" -j2 nhdyn_bench
+scalar="${NHDYN_BENCH_SCALAR:-1}"
+targets=(nhdyn_bench); [ "$scalar" = 1 ] && targets+=(nhdyn_bench_scalar)
+make -C "$build" -j2 "${targets[@]}"
 
 json="$root/docs/performance.json"
 [ $docs -eq 0 ] && json="$build/performance.json"
-"$build/bench/nhdyn_bench" --benchmark_repetitions="$reps" --benchmark_report_aggregates_only=true \
+"$build/bench/nhdyn_bench" --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true \
   --benchmark_min_time="$min_time" --benchmark_filter="$filter" \
   --benchmark_out="$json" --benchmark_out_format=json
 echo "bench.sh: wrote $json"
@@ -39,3 +46,11 @@ cpu="$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -1)"
 compiler="$("$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")" --version | head -1)"
 "$py" "$root/scripts/perf_table.py" "$json" "$root/docs/performance.md" "$root/docs/performance_scaling.png" \
   --cpu "$cpu" --compiler "$compiler"
+
+if [ "$scalar" = 1 ]; then
+  sjson="$root/docs/performance-scalar.json"
+  "$build/bench/nhdyn_bench_scalar" --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true \
+    --benchmark_min_time="$min_time" --benchmark_out="$sjson" --benchmark_out_format=json
+  echo "bench.sh: wrote $sjson"
+  "$py" "$root/scripts/scalar_table.py" "$sjson" "$root/docs/performance.md" --cpu "$cpu" --compiler "$compiler"
+fi
