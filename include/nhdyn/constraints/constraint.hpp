@@ -231,14 +231,7 @@ struct differential_drive {
   vecN<T, m_at_compile_time> St_times_in_place(const Eigen::MatrixBase<Q>&, vecN<T, N>&& v,
                                                const detail::sin_cos<T>& p) const {
     if constexpr (N == dynamic) {
-      const int lo = std::min(x, y), hi = std::max(x, y);
-      int c = 0;
-      for (int j = 0; j < n; ++j) {
-        if (j == lo)
-          v(c++) = p.c * v(x) + p.s * v(y);
-        else if (j != hi)
-          v(c++) = v(j);
-      }
+      St_times_into(v, p, v);
       v.conservativeResize(n - 1);
       return std::move(v);
     } else {
@@ -250,9 +243,16 @@ struct differential_drive {
   /// Sᵀv into a new vector of m entries, with sin/cos of ψ known (v: any Eigen vector of n).
   template <class V, class T>
   vecN<T, m_at_compile_time> St_times(const Eigen::MatrixBase<V>& v, const detail::sin_cos<T>& p) const {
-    const int lo = std::min(x, y), hi = std::max(x, y);
     vecN<T, m_at_compile_time> out;
     out.resize(n - 1);
+    St_times_into(v, p, out);
+    return out;
+  }
+  /// Sᵀv into the first m entries of out, which may be v itself: entry c is written after
+  /// every entry ≥ c it needs has been read (c ≤ j, and v(x), v(y) are read at j = min(x, y)).
+  template <class V, class T, class Out>
+  void St_times_into(const Eigen::MatrixBase<V>& v, const detail::sin_cos<T>& p, Eigen::MatrixBase<Out>& out) const {
+    const int lo = std::min(x, y), hi = std::max(x, y);
     int c = 0;
     for (int j = 0; j < n; ++j) {
       if (j == lo)
@@ -260,7 +260,6 @@ struct differential_drive {
       else if (j != hi)
         out(c++) = v(j);
     }
-    return out;
   }
   /// (q̇, q̈) = (S η, S η̇ + Ṡ η) in one pass and one sin/cos of ψ, written into qd and qdd
   /// (n entries each): the lift's work (constraints/stages.hpp uses it when a constraint has
