@@ -35,6 +35,16 @@ template <class C>
 struct constraint_scalar<C> {
   using type = typename C::scalar_type;
 };
+/// The lift's input checks: sizes n, m, m, then every entry finite.
+template <class C, class Q, class E, class ED>
+void check_reduced_state(const C& c, const Q& q, const E& eta, const ED& eta_dot) {
+  check_size(q, c.dof(), "q");
+  check_size(eta, c.m(), "eta");
+  check_size(eta_dot, c.m(), "eta_dot");
+  check_finite(q, "q");
+  check_finite(eta, "eta");
+  check_finite(eta_dot, "eta_dot");
+}
 }  // namespace detail
 
 template <class C>
@@ -48,12 +58,7 @@ class lift_fn : public stage_tag {
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                   const Eigen::MatrixBase<ED>& eta_dot) const {
     constexpr int N = C::n_at_compile_time;
-    detail::check_size(q, c_.dof(), "q");
-    detail::check_size(eta, c_.m(), "eta");
-    detail::check_size(eta_dot, c_.m(), "eta_dot");
-    detail::check_finite(q, "q");
-    detail::check_finite(eta, "eta");
-    detail::check_finite(eta_dot, "eta_dot");
+    detail::check_reduced_state(c_, q, eta, eta_dot);
     using TL = promote_t<promote_t<promote_t<typename detail::constraint_scalar<C>::type, typename Q::Scalar>, typename E::Scalar>,
                          typename ED::Scalar>;
     if constexpr (requires(vecN<TL, N>& v) { c_.lift_into(q, eta, eta_dot, v, v); }) {
@@ -244,9 +249,7 @@ auto nh_pipeline(const chain<S, N>& ch, const C& c, rne_options o, Out out) {
   else
     return compose(std::move(out), rne(ch, o), resize_fn<N>{}, lift(c));
 }
-}  // namespace detail
 
-namespace detail {
 /// Whether inverse_dynamics over a run-time-sized chain of model scalar S can take the
 /// call (q, η, η̇) on stack scratch: a constraint that lifts into given storage (lift_into),
 /// projects with the lift's memo (St_times) and has SᵀS = I and no E, and a state whose
@@ -294,12 +297,7 @@ struct scratch_inverse_dynamics : Composed {
     const auto& r = this->g.f;          // rne (this->g.g is the lift)
     using T = promote_t<promote_t<promote_t<typename constraint_scalar<C>::type, typename Q::Scalar>, typename E::Scalar>,
                         typename ED::Scalar>;
-    check_size(q, c.dof(), "q");  // the lift's checks, in its order
-    check_size(eta, c.m(), "eta");
-    check_size(eta_dot, c.m(), "eta_dot");
-    check_finite(q, "q");
-    check_finite(eta, "eta");
-    check_finite(eta_dot, "eta_dot");
+    check_reduced_state(c, q, eta, eta_dot);  // the lift's checks
     const int n = c.dof();
     small_buffer<T, dynamic, 256> qd_store(n), v_store(n);  // beyond 256 joints, on the heap
     Eigen::Map<vecN<T, dynamic>> qd(qd_store.data(), n), v(v_store.data(), n);
