@@ -21,6 +21,13 @@
 
 namespace nhdyn_bench {
 
+/// The cross-product matrix: skew(v) w = v × w.
+inline Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d S;
+  S << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return S;
+}
+
 class lagrange_terms {
  public:
   explicit lagrange_terms(const nhdyn::chain<double>& c) : c_(c), kin_(c), n_(c.dof()) {}
@@ -83,7 +90,7 @@ class lagrange_terms {
         auto D = dM[std::size_t(k)].topLeftCorner(w, w);
         D += P + P.transpose();
         if (rev(k)) {
-          const Eigen::Matrix3d Z = nhdyn::detail::skew(zk);
+          const Eigen::Matrix3d Z = skew(zk);
           const Eigen::Matrix3d dI0 = Z * I0 - I0 * Z;
           D.noalias() += jw.transpose() * dI0 * jw;
         }
