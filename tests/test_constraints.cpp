@@ -132,6 +132,13 @@ TEST_CASE("differential_drive: any (x, y, heading) triple, forward offset and he
       REQUIRE((nhdyn::apply_S(c, q, eta) - S * eta).cwiseAbs().maxCoeff() < 1e-15);
       REQUIRE((nhdyn::apply_St(c, q, v) - S.transpose() * v).cwiseAbs().maxCoeff() < 1e-14);
       REQUIRE((nhdyn::apply_Sdot(c, q, qd, eta) - Sd * eta).cwiseAbs().maxCoeff() < 1e-14);
+      // Sᵀ M S of a symmetric M, structured (O(n²)) against the dense products.
+      Mat B(hc.n, hc.n);
+      for (int j = 0; j < hc.n; ++j) B.col(j) = R.vec(hc.n, 3.0);
+      const Mat M = B * B.transpose();
+      const Mat MS = c.St_M_S(q, M), MS_dense = S.transpose() * M * S;
+      REQUIRE((MS - MS_dense).cwiseAbs().maxCoeff() < 1e-13 * M.cwiseAbs().maxCoeff());
+      REQUIRE(MS == MS.transpose());
     }
   }
   report("differential_drive max |A S|", worst_AS);
@@ -196,6 +203,43 @@ TEST_CASE("inverse_dynamics, run-time sized: the stack-scratch call is project �
       const Vec huge = Vec::Constant(n - 1, 1e300);
       CHECK_THROWS_AS(nhdyn::inverse_dynamics(ch, c)(q, huge, huge), nhdyn::numerical_error);
     }
+  }
+}
+
+TEST_CASE("inverse_dynamics, compile-time sized: the stack-scratch call is project ∘ rne ∘ lift, bit for bit") {
+  // Compile-time sized, (q, η, η̇) with a floating-point state also runs on stack scratch
+  // (q̇, q̈, v never move between stages); the stages composed by hand pass fixed-size values
+  // along. The same numbers. (A dual state takes the composition itself: checked too.)
+  const auto r = nhdyn::presets::paper5();
+  using V5 = Eigen::Matrix<double, 5, 1>;
+  using V4 = Eigen::Matrix<double, 4, 1>;
+  rng R;
+  for (const auto& c : {r.constraint, nhdyn::differential_drive<double, 5>(5, 1, 0, 2, 0.3, 1.0)}) {
+    for (const nhdyn::rne_options o : {nhdyn::rne_options{}, nhdyn::rne_options{false, true}, nhdyn::rne_options{true, false}}) {
+      const auto id = nhdyn::inverse_dynamics(r.chain, c, o);
+      const auto by_hand = nhdyn::lift(c) | nhdyn::rne(r.chain, o) | nhdyn::project(c);
+      for (int k = 0; k < 20; ++k) {
+        const V5 q = R.vec(5, 3.0);
+        const V4 eta = R.vec(4, 2.0), etad = R.vec(4, 2.0);
+        const V4 tau = id(q, eta, etad);
+        REQUIRE(tau == V4(by_hand(q, eta, etad)));
+        using D = nhdyn::dual<double, 2>;
+        Eigen::Matrix<D, 5, 1> qd = q.cast<D>();
+        qd(3).derivative(0) = 1.0;
+        Eigen::Matrix<D, 4, 1> ed = eta.cast<D>();
+        ed(1).derivative(1) = 1.0;
+        const auto t1 = id(qd, ed, etad);
+        const auto t2 = by_hand(qd, ed, etad.cast<D>().eval());
+        for (int i = 0; i < 4; ++i) {
+          REQUIRE(t1(i).value() == t2(i).value());
+          REQUIRE(t1(i).derivative(0) == t2(i).derivative(0));
+          REQUIRE(t1(i).derivative(1) == t2(i).derivative(1));
+        }
+      }
+    }
+    V4 bad = V4::Constant(0.1);
+    bad(3) = std::numeric_limits<double>::infinity();
+    CHECK_THROWS_WITH(nhdyn::inverse_dynamics(r.chain, c)(V5::Zero().eval(), V4::Zero().eval(), bad), Catch::Contains("eta_dot"));
   }
 }
 

@@ -5,6 +5,8 @@
 //    which are the derivatives to ≥ 30 digits: the dual Jacobian must agree to 1e-9 relative
 //    (in fact to a few ulps), and a dual<mp50> Jacobian to 1e-30.
 #include <catch2/catch.hpp>
+#include <algorithm>
+#include <numbers>
 #include <nhdyn/analysis/linearize.hpp>
 #include <nhdyn/nhdyn.hpp>
 #include <nhdyn/scalar/multiprecision.hpp>
@@ -49,8 +51,10 @@ TEST_CASE("linearize: dtau/dzeta of paper5 by duals matches 50-digit finite diff
   INFO("dual J:\n" << lin.J << "\nmp50 FD:\n" << ref);
   CHECK(rel_err(lin.J, ref) < 1e-9);
   CHECK(rel_err(lin.J, ref) < 1e-13);  // duals are exact up to rounding: a few ulps
-  // ∂τ/∂η̇ is the reduced inertia M_η = SᵀMS (E = S, SᵀS = I): an independent CRBA path.
-  const auto Me = nhdyn::nh_forward_dynamics(r.chain, r.constraint).reduced_inertia(q0);
+  // ∂τ/∂η̇ is the reduced inertia M_η = SᵀMS (E = S, SᵀS = I); the linearizer takes it from
+  // CRBA, so compare with M_η built the other way, column by column from rne (q̈ = S e_j).
+  const auto Me = nhdyn::nh_forward_dynamics(r.chain, r.constraint, {}, nhdyn::reduced_inertia_method::rne_columns)
+                      .reduced_inertia(q0);
   CHECK(rel_err(lin.deta_dot(), Me) < 1e-13);
   // τ does not depend on the base position (q₁, q₂): translation invariance in the ground plane.
   CHECK(lin.dq().leftCols(2).cwiseAbs().maxCoeff() < 1e-12);
@@ -224,9 +228,10 @@ TEST_CASE("linearize: jacobian of a user pipeline with a user stage, and bad siz
 TEST_CASE("linearize: the linearizer skips only columns that vanish, and the rest equal full seeding") {
   const auto r = nhdyn::presets::paper5();
   const nhdyn::inverse_dynamics_linearizer lin(r.chain, r.constraint);
-  // paper5: q₁, q₂ (the base's x and y, prismatic, before every revolute joint, not the heading).
-  REQUIRE(lin.computed_columns().size() == 11u);
-  CHECK(lin.computed_columns().front() == 2);
+  // paper5: dual directions q₄, q₅ and η; not q₁, q₂ (the base's x and y, prismatic,
+  // before every revolute joint) nor q₃ (the heading: a planar base under vertical gravity
+  // turns freely); η̇ from the mass matrix.
+  REQUIRE(lin.computed_columns() == std::vector<int>{3, 4, 5, 6, 7, 8});
   V13 z;
   z << q0, eta0, etad0;
   const auto id = nhdyn::inverse_dynamics(r.chain, r.constraint);
@@ -235,23 +240,96 @@ TEST_CASE("linearize: the linearizer skips only columns that vanish, and the res
     const V13 zs = s * z;
     const auto full = nhdyn::jacobian(f, zs);  // every column seeded (dual<double, 13>)
     const auto J = lin(zs.head<5>(), zs.segment<4>(5), zs.tail<4>()).J;
-    // Columns 1–2 vanish in the full computation too: exactly, not just to rounding.
+    // Columns 1–2 vanish in the full computation too: exactly, not just to rounding;
+    // column 3 (the heading) to rounding.
     CHECK(full.leftCols(2).cwiseAbs().maxCoeff() == 0.0);
-    // Each derivative lane is computed by the same operations: the same numbers.
-    CHECK((J - full).cwiseAbs().maxCoeff() == 0.0);
+    CHECK(J.leftCols(3).cwiseAbs().maxCoeff() == 0.0);
+    CHECK(full.col(2).cwiseAbs().maxCoeff() < 1e-15 * full.cwiseAbs().maxCoeff());
+    // Each seeded derivative lane is computed by the same operations: the same numbers.
+    CHECK((J.middleCols(3, 6) - full.middleCols(3, 6)).cwiseAbs().maxCoeff() == 0.0);
+    // ∂τ/∂η̇ by CRBA (SᵀMS) against the η̇ lanes of the dual rne: a different algorithm,
+    // equal to rounding.
+    CHECK(rel_err(J.rightCols(4), full.rightCols(4)) < 1e-14);
   }
   // A user constraint may depend on any joint: nothing skipped. The same S as paper5's.
   const auto c = r.constraint;
   const auto user = nhdyn::make_constraint(
       5, 1, [c](const auto& q) { return c.A(q); }, [c](const auto& q) { return c.S(q); });
   const nhdyn::inverse_dynamics_linearizer lu(r.chain.dynamic_size(), user);
-  CHECK(lu.computed_columns().size() == 13u);
+  CHECK(lu.computed_columns().size() == 9u);  // all of (q, η)
   const Eigen::VectorXd qd = q0, ed = eta0, edd = etad0;
   CHECK(rel_err(lu(qd, ed, edd).J, lin(q0, eta0, etad0).J) < 1e-13);
+  // SᵀS ≠ I and an input map E ≠ S: ∂τ/∂η̇ = (SᵀE)⁻¹SᵀMS, against every column seeded.
+  using MX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic>;
+  const auto scaledS = [c](const auto& q) {
+    using T = typename std::decay_t<decltype(q)>::Scalar;
+    Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> S = c.S(q);
+    for (int j = 0; j < 4; ++j) S.col(j) *= T(0.5 + 0.7 * j);
+    return S;
+  };
+  const auto inputE = [c, scaledS](const auto& q) {
+    using T = typename std::decay_t<decltype(q)>::Scalar;
+    MX G(4, 4), W(1, 4);
+    G << 1.0, 0.2, 0, 0, -0.1, 0.9, 0, 0.3, 0, 0, 1.2, 0.1, 0.2, 0, 0, 0.8;
+    W << 0.3, -0.4, 0.1, 0.2;
+    return Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>(scaledS(q) * G.cast<T>() +
+                                                            Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>(c.A(q)).transpose() * W.cast<T>());
+  };
+  const auto userE = nhdyn::make_constraint(
+      5, 1, [c](const auto& q) { return c.A(q); }, scaledS, nullptr, inputE);
+  const auto dyn = r.chain.dynamic_size();
+  const auto idE = nhdyn::inverse_dynamics(dyn, userE);
+  const auto fE = [&](const auto& x) { return idE(x.head(5), x.segment(5, 4), x.tail(4)); };
+  const Eigen::VectorXd zd = z;
+  const auto fullE = nhdyn::jacobian(fE, zd);
+  const auto JE = nhdyn::inverse_dynamics_linearizer(dyn, userE)(qd, ed, edd).J;
+  INFO("linearizer:\n" << JE << "\nfull seeding:\n" << fullE);
+  CHECK(rel_err(JE.leftCols(9), fullE.leftCols(9)) == 0.0);
+  CHECK(rel_err(JE.rightCols(4), fullE.rightCols(4)) < 1e-13);
+  CHECK(rel_err(JE, nhdyn::central_difference_jacobian(fE, zd, 1e-6)) < 1e-8);
+  // The heading is skipped only when turning it is a symmetry. Each of these breaks it, and
+  // the full computation then has a heading column far from zero: gravity not along the
+  // heading axis; the heading's sign against the x–y orientation; a third base joint
+  // sliding across the heading axis.
+  {
+    const V13 zs = z;
+    auto tilted = r;
+    tilted.chain = nhdyn::chain<double, 5>(r.chain.links(), Eigen::Vector3d(-9.7, 1.5, 0.8), "tilted");
+    auto flipped = r;
+    flipped.constraint.heading_sign = -r.constraint.heading_sign;
+    for (const auto* m : {&tilted, &flipped}) {
+      const nhdyn::inverse_dynamics_linearizer lm(m->chain, m->constraint);
+      CHECK(lm.computed_columns().front() == 2);
+      const auto idm = nhdyn::inverse_dynamics(m->chain, m->constraint);
+      const auto fm = [&](const auto& x) { return idm(x.template head<5>(), x.template segment<4>(5), x.template tail<4>()); };
+      const auto fullm = nhdyn::jacobian(fm, zs);
+      CHECK(fullm.col(2).cwiseAbs().maxCoeff() > 1e-3);
+      CHECK((lm(zs.head<5>(), zs.segment<4>(5), zs.tail<4>()).J.leftCols(9) - fullm.leftCols(9)).cwiseAbs().maxCoeff() == 0.0);
+    }
+    // A third base joint before the heading, sliding across the heading axis (inserted first,
+    // massless, turning the frames after it by α = π/2 about the x axis, which is the heading
+    // axis and gravity's: those stay parallel). Not a symmetry: the heading is seeded.
+    std::vector<nhdyn::link<double>> links6{nhdyn::link<double>{nhdyn::joint_type::prismatic, std::numbers::pi / 2}};
+    links6.insert(links6.end(), r.chain.begin(), r.chain.end());
+    const nhdyn::chain<double> six(links6, r.chain.gravity(), "six");
+    const nhdyn::differential_drive<double> dd6(6, 1, 2, 3, r.constraint.forward_offset, r.constraint.heading_sign);
+    const nhdyn::inverse_dynamics_linearizer l6(six, dd6);
+    const auto& cols6 = l6.computed_columns();
+    CHECK(std::find(cols6.begin(), cols6.end(), 3) != cols6.end());
+    Eigen::VectorXd z6(16);
+    z6 << 0.3, q0, 0.2, eta0, -0.4, etad0;
+    const auto id6 = nhdyn::inverse_dynamics(six, dd6);
+    const auto f6 = [&](const auto& x) { return id6(x.head(6), x.segment(6, 5), x.tail(5)); };
+    const auto full6 = nhdyn::jacobian(f6, z6);
+    CHECK(full6.col(3).cwiseAbs().maxCoeff() > 1e-3);
+    const auto J6 = l6(z6.head(6), z6.segment(6, 5), z6.tail(5)).J;
+    CHECK((J6.leftCols(11) - full6.leftCols(11)).cwiseAbs().maxCoeff() == 0.0);
+    CHECK(rel_err(J6.rightCols(5), full6.rightCols(5)) < 1e-14);
+  }
   // A revolute joint first: a translation after it is not a symmetry; nothing skipped.
   auto links = std::vector<nhdyn::link<double>>(r.chain.begin(), r.chain.end());
   std::swap(links[0], links[2]);
   const nhdyn::chain<double> turned(links, r.chain.gravity(), "turned");
   const nhdyn::differential_drive<double> dd(5, 1, 2, 0, 0.0, -1.0);
-  CHECK(nhdyn::inverse_dynamics_linearizer(turned, dd).computed_columns().size() == 13u);
+  CHECK(nhdyn::inverse_dynamics_linearizer(turned, dd).computed_columns().size() == 9u);  // all of (q, η)
 }

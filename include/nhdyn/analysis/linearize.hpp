@@ -23,6 +23,8 @@
 ///   or `link_parameter_jacobian(chain, c, q, η, η̇)`: ∂τ/∂(m_i, a_i, d_i, I_xx,i, I_yy,i,
 ///   I_zz,i) for every link i (columns link by link).
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <limits>
 #include <type_traits>
 #include <vector>
 
@@ -129,73 +131,145 @@ auto stack3(const A& a, const B& b, const C& c) {
 }
 }  // namespace detail
 
+namespace detail {
+template <class C>
+inline constexpr bool is_differential_drive = false;
+template <class Sc, int N>
+inline constexpr bool is_differential_drive<differential_drive<Sc, N>> = true;
+
+/// Whether turning a differential drive's heading joint h is a symmetry of its reduced
+/// dynamics, so that ∂τ/∂q_h vanishes identically: every joint before h is prismatic (the
+/// base only translates up to it), the x and y joints' axes are orthonormal, perpendicular
+/// to the heading axis a_h and oriented so that ψ = sign·q_h turns the forward direction
+/// with the body (sign·(a_x × a_y) = a_h), every other joint before h slides along a_h, and
+/// gravity (when on) is parallel to a_h. Then turning the heading and the whole scene about
+/// a_h together changes nothing that τ = (τ_v, τ_ω, …) reads: v is measured along the body's
+/// forward direction, and every force on the arm turns with it. Checked on the model's
+/// constants to rounding (8ε); any other case — and every model scalar other than a
+/// floating-point one — is not skipped.
+template <class S, int N, class C>
+bool heading_turn_is_symmetry(const chain<S, N>& ch, const C& c, const rne_options& o) {
+  if constexpr (!is_differential_drive<C> || !std::is_floating_point_v<S>) {
+    return false;
+  } else {
+    const int h = c.heading;
+    if (c.x > h || c.y > h || ch[h].joint != joint_type::revolute) return false;
+    // Joint j's axis z_{j−1} in the base frame: R_0 ⋯ R_{j−1} ẑ, R_i = Rz(θ_i) Rx(α_i).
+    std::vector<Eigen::Vector3d> axis;
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+    for (int j = 0; j <= h; ++j) {
+      axis.push_back(R.col(2));
+      if (j < h && ch[j].joint != joint_type::prismatic) return false;
+      const double th = double(ch[j].theta), al = double(ch[j].alpha);
+      R = R * Eigen::AngleAxisd(th, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+          Eigen::AngleAxisd(al, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    }
+    const double tol = 8 * std::numeric_limits<double>::epsilon();
+    const Eigen::Vector3d& ah = axis[std::size_t(h)];
+    const Eigen::Vector3d& ax = axis[std::size_t(c.x)];
+    const Eigen::Vector3d& ay = axis[std::size_t(c.y)];
+    const auto parallel = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+      return a.cross(b).norm() <= tol * a.norm() * b.norm();
+    };
+    if (std::abs(ax.dot(ah)) > tol || std::abs(ay.dot(ah)) > tol || std::abs(ax.dot(ay)) > tol) return false;
+    if ((double(c.heading_sign) * ax.cross(ay) - ah).norm() > tol) return false;
+    for (int j = 0; j < h; ++j)
+      if (j != c.x && j != c.y && !parallel(axis[std::size_t(j)], ah)) return false;
+    const Eigen::Vector3d g = ch.gravity().template cast<double>();
+    return !o.gravity || g.norm() == 0 || parallel(g, ah);
+  }
+}
+}  // namespace detail
+
 /// ∂τ/∂(q, η, η̇) as a function object: the pipeline project∘rne∘lift is built once (as
-/// `inverse_dynamics` is), and every call evaluates it once on duals seeded along all of
-/// ζ = (q, η, η̇) (compile-time sizes ≤ 16: one pass).
+/// `inverse_dynamics` is), with a composite-rigid-body pass beside it.
 ///
 ///     const nhdyn::inverse_dynamics_linearizer lin(chain, constraint);
 ///     auto J = lin(q, eta, eta_dot);   // J.J (m × (n + 2m)), J.dq(), J.deta(), J.deta_dot()
 ///
-/// Columns known to vanish are not computed: ∂τ/∂q_j = 0 for a prismatic joint j that comes
-/// before every revolute joint (it translates everything after it, and the dynamics does
-/// not change under a translation) when the constraint does not depend on q_j
+/// τ is affine in η̇: τ = (SᵀE)⁻¹Sᵀ(M(q)(Sη̇ + Ṡη) + c(q, Sη) + g(q)), so ∂τ/∂η̇ =
+/// (SᵀE)⁻¹SᵀM(q)S (= M_η when E = S and SᵀS = I) is taken from the mass matrix (CRBA, as
+/// Pinocchio's computeRNEADerivatives takes ∂τ/∂q̈ = M), and one evaluation of the pipeline
+/// on duals seeded along (q, η) only, η̇ held constant, gives ∂τ/∂q and ∂τ/∂η.
+///
+/// Columns known to vanish are not seeded either: ∂τ/∂q_j = 0 for a prismatic joint j that
+/// comes before every revolute joint (it translates everything after it, and the dynamics
+/// does not change under a translation) when the constraint does not depend on q_j
 /// (`differential_drive` depends on its heading joint only; `holonomic` on none; a user
-/// constraint on all). A planar base's x and y are such joints: for paper5, 11 of the 13
-/// columns are seeded. The skipped columns are exact zeros, and the rest are the same
-/// numbers as with every column seeded (tests/test_linearize.cpp checks both).
+/// constraint on all). A planar base's x and y are such joints. So is a differential
+/// drive's heading when turning it is a symmetry (detail::heading_turn_is_symmetry: a
+/// planar base under vertical gravity). For paper5: 6 dual directions (q₄, q₅, η) instead
+/// of 13. The skipped columns vanish in the full computation (x, y exactly; the heading to
+/// rounding, 1e-18 of 10), the seeded ones are the same numbers as with every column seeded,
+/// and the η̇ block agrees with it to rounding (tests/test_linearize.cpp checks all three).
 template <class S, int N, class C>
 class inverse_dynamics_linearizer {
  public:
   inverse_dynamics_linearizer(const chain<S, N>& ch, const C& c, rne_options o = {})
-      : id_(inverse_dynamics(ch, c, o)), n_(c.dof()), m_(c.m()) {
-    const int z = n_ + 2 * m_;
+      : id_(inverse_dynamics(ch, c, o)), M_(ch), c_(c), n_(c.dof()), m_(c.m()) {
     bool before_revolute = true;
-    for (int j = 0; j < z; ++j) {
+    const bool heading_symmetry = detail::heading_turn_is_symmetry(ch, c, o);
+    for (int j = 0; j < n_ + m_; ++j) {
       if (j < n_) before_revolute = before_revolute && ch[j].joint == joint_type::prismatic;
-      const bool zero = j < n_ && before_revolute && !constraint_depends_on(c, j);
+      bool zero = j < n_ && before_revolute && !constraint_depends_on(c, j);
+      if constexpr (detail::is_differential_drive<C>) zero = zero || (heading_symmetry && j == c.heading);
       if (!zero) cols_.push_back(j);
     }
   }
 
-  /// The columns of ∂τ/∂ζ that are computed (the others are structurally zero).
+  /// The columns of ∂τ/∂ζ seeded as dual directions (of q and η; the others of q are
+  /// structurally zero, and the η̇ block comes from the mass matrix).
   const std::vector<int>& computed_columns() const { return cols_; }
 
   template <class Q, class E, class ED>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                   const Eigen::MatrixBase<ED>& eta_dot) const {
     constexpr int M = C::m_at_compile_time;
-    constexpr int Z = detail::stacked<N, M>;
+    constexpr int X = (N == dynamic || M == dynamic) ? dynamic : N + M;  // x = (q, η)
     if constexpr (N == dynamic) detail::check_size(q, n_, "q");
     detail::check_size(eta, m_, "eta");
     detail::check_size(eta_dot, m_, "eta_dot");
     const int n = n_, m = m_;
-    const auto f = [&](const auto& z) {
-      if constexpr (Z != dynamic)
-        return id_(z.template head<N>(), z.template segment<M>(N), z.template tail<M>());
-      else
-        return id_(z.head(n), z.segment(n, m), z.tail(m));
-    };
     using T = typename Q::Scalar;
+    const vecN<T, M> ed = eta_dot.template cast<T>();
+    const auto f = [&](const auto& x) {
+      using D = typename std::decay_t<decltype(x)>::Scalar;
+      const vecN<D, M> edd = ed.template cast<D>();  // constant: no derivative lanes seeded
+      if constexpr (X != dynamic)
+        return id_(x.template head<N>(), x.template tail<M>(), edd);
+      else
+        return id_(x.head(n), x.tail(m), edd);
+    };
     inverse_dynamics_jacobian<T, N, M> out;
     out.n = n;
     out.m = m;
-    const auto z = detail::stack3<Z>(q.template cast<T>(), eta, eta_dot);
+    vecN<T, X> x(n + m);
+    x << q.template cast<T>(), eta.template cast<T>();
     const int nc = static_cast<int>(cols_.size());
-    constexpr int K = detail::seed_chunk<Z>;
-    // A fixed-size ζ with exactly two vanishing columns (a planar base's x and y) gets its
-    // own, narrower dual; any other count seeds K at a time.
-    if constexpr (Z != dynamic && K > 2) {
-      if (nc == Z - 2) {
-        out.J = detail::jacobian_columns<K - 2>(f, z, cols_.data(), nc);
-        return out;
+    constexpr int K = detail::seed_chunk<X>;
+    out.J.resize(m, n + 2 * m);
+    // A fixed-size x with two or three vanishing columns (a planar base's x and y, and its
+    // heading) gets its own, narrower dual; any other count seeds K at a time.
+    bool done = false;
+    if constexpr (X != dynamic && K > 3) {
+      if (nc == X - 2) {
+        out.J.leftCols(n + m) = detail::jacobian_columns<K - 2>(f, x, cols_.data(), nc);
+        done = true;
+      } else if (nc == X - 3) {
+        out.J.leftCols(n + m) = detail::jacobian_columns<K - 3>(f, x, cols_.data(), nc);
+        done = true;
       }
     }
-    out.J = detail::jacobian_columns<K>(f, z, cols_.data(), nc);
+    if (!done) out.J.leftCols(n + m) = detail::jacobian_columns<K>(f, x, cols_.data(), nc);
+    // ∂τ/∂η̇ = (SᵀE)⁻¹ SᵀM S (q was checked by the dual evaluation above).
+    out.J.rightCols(m) = detail::solve_StE(c_, q, detail::project_inertia<T>(c_, q, M_(q)));
     return out;
   }
 
  private:
   decltype(inverse_dynamics(std::declval<const chain<S, N>&>(), std::declval<const C&>())) id_;
+  mass_matrix_fn<S, N> M_;
+  C c_;
   int n_, m_;
   std::vector<int> cols_;
 };

@@ -8,8 +8,9 @@
 ///
 /// A constraint type provides `dof()` (n), `k()`, `m()` and, templated on the scalar,
 /// `A(q)` (k×n), `S(q)` (n×m), `Sdot(q, qd)` (n×m). Optionally `E(q)` (n×m), and the
-/// structured products `S_times(q, η)`, `St_times(q, v)`, `Sdot_times(q, q̇, η)` that avoid
-/// forming matrices; the free functions below fall back to the dense forms.
+/// structured products `S_times(q, η)`, `St_times(q, v)`, `Sdot_times(q, q̇, η)` and
+/// `St_M_S(q, M)` (the reduced inertia SᵀMS of a symmetric M) that avoid forming matrices;
+/// the free functions below fall back to the dense forms.
 ///
 /// Built in: `holonomic` (S = I, k = 0), `differential_drive` (any x, y, heading triple of
 /// joints, forward axis a parameter), `user_constraint` (plain functions of q; Ṡ by duals
@@ -148,14 +149,23 @@ struct differential_drive {
     a(0, y) = p.c;
     return a;
   }
+  /// S(q): the column of v is (cos ψ, sin ψ) in the x and y rows; every other joint has its
+  /// own unit column (the same layout as S_times, with one sin/cos of ψ).
   template <class Q>
   auto S(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<Sc, typename Q::Scalar>;
     matrix<T, N, m_at_compile_time> s = matrix<T, N, m_at_compile_time>::Zero(n, n - 1);
-    for (int c = 0; c < n - 1; ++c) {
-      vecN<T, m_at_compile_time> e = vecN<T, m_at_compile_time>::Zero(n - 1);
-      e(c) = T(1);
-      s.col(c) = S_times(q, e);
+    const auto p = sincos_psi(T(q(heading)));
+    const int lo = std::min(x, y), hi = std::max(x, y);
+    int c = 0;
+    for (int j = 0; j < n; ++j) {
+      if (j == lo) {
+        s(x, c) = p.c;
+        s(y, c) = p.s;
+        ++c;
+      } else if (j != hi) {
+        s(j, c++) = T(1);
+      }
     }
     return s;
   }
@@ -260,6 +270,38 @@ struct differential_drive {
       else if (j != hi)
         out(c++) = v(j);
     }
+  }
+  /// Sᵀ M S for a symmetric n×n M (the reduced inertia M_η from the joint-space M), in O(n²)
+  /// with one sin/cos of ψ: M's rows and columns with the y joint's folded into the x joint's
+  /// as the v row/column (cos ψ·M_x + sin ψ·M_y), every other joint's copied.
+  template <class Q, class MM>
+  auto St_M_S(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<MM>& M) const {
+    using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename MM::Scalar>;
+    const auto p = sincos_psi(T(q(heading)));
+    const int lo = std::min(x, y), hi = std::max(x, y);
+    // M's row (or column, M = Mᵀ) of joint j, seen from the v direction: cos ψ M_xj + sin ψ M_yj.
+    const auto v_row = [&](int j) { return T(p.c * M(x, j) + p.s * M(y, j)); };
+    matrix<T, m_at_compile_time, m_at_compile_time> out(n - 1, n - 1);
+    for (int i = 0, ci = 0; i < n; ++i) {
+      if (i == hi) continue;
+      for (int j = 0, cj = 0; j <= i; ++j) {
+        if (j == hi) continue;
+        T e;
+        if (i == lo && j == lo)
+          e = T(p.c * v_row(x) + p.s * v_row(y));
+        else if (i == lo)
+          e = v_row(j);
+        else if (j == lo)
+          e = v_row(i);
+        else
+          e = T(M(i, j));
+        out(ci, cj) = e;
+        out(cj, ci) = e;
+        ++cj;
+      }
+      ++ci;
+    }
+    return out;
   }
   /// (q̇, q̈) = (S η, S η̇ + Ṡ η) in one pass and one sin/cos of ψ, written into qd and qdd
   /// (n entries each): the lift's work (constraints/stages.hpp uses it when a constraint has
@@ -422,6 +464,21 @@ bool constraint_depends_on(const C& c, int j) {
   else
     return true;
 }
+
+namespace detail {
+/// Sᵀ M S in the scalar T for a symmetric M: the constraint's structured `St_M_S` when it has
+/// one (differential_drive: O(n²)), else dense products (O(n²m)).
+template <class T, class C, class Q, class MM>
+matrix<T, C::m_at_compile_time, C::m_at_compile_time> project_inertia(const C& c, const Eigen::MatrixBase<Q>& q,
+                                                                      const Eigen::MatrixBase<MM>& M) {
+  if constexpr (requires { c.St_M_S(q, M); }) {
+    return c.St_M_S(q, M).template cast<T>();
+  } else {
+    const auto S = c.S(q);
+    return (S.transpose().template cast<T>() * M.template cast<T>() * S.template cast<T>());
+  }
+}
+}  // namespace detail
 
 template <class C, class Q>
 auto input_map(const C& c, const Eigen::MatrixBase<Q>& q) {

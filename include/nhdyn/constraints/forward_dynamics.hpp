@@ -35,9 +35,7 @@ class nh_forward_dynamics_fn : public stage_tag {
     const int m = c_.m();
     matrix<T, M, M> Me(m, m);
     if (method_ == reduced_inertia_method::crba) {
-      const auto Mq = M_(q);
-      const auto Sq = c_.S(q);
-      Me = (Sq.transpose().template cast<T>() * Mq * Sq.template cast<T>());
+      Me = detail::project_inertia<T>(c_, q, M_(q));
     } else {
       const vecN<T, N> zero = vecN<T, N>::Zero(c_.dof());
       for (int j = 0; j < m; ++j) {

@@ -97,22 +97,23 @@ lift_fn<C> lift(C c) {
 }
 
 namespace detail {
-/// (SᵀE)⁻¹ r, for a right-hand side r of m entries (taken by value: with SᵀS = I and no E
-/// it is the answer, returned without a copy).
+/// (SᵀE)⁻¹ r, for a right-hand side r of m rows (a vector, or a matrix of columns; taken by
+/// value: with SᵀS = I and no E it is the answer, returned without a copy).
 template <class C, class Q, class R>
 auto solve_StE(const C& c, const Eigen::MatrixBase<Q>& q, R r) {
   using T = typename R::Scalar;
   constexpr int M = C::m_at_compile_time;
+  using P = Eigen::Matrix<T, M, R::ColsAtCompileTime>;  // vecN<T, M> for a vector r
   constexpr bool has_E = requires { c.E(q); };
-  if constexpr (C::orthonormal_S && !has_E && std::is_same_v<R, vecN<T, M>>) {
+  if constexpr (C::orthonormal_S && !has_E && std::is_same_v<R, P>) {
     return r;
   } else if constexpr (C::orthonormal_S && !has_E) {
-    return vecN<T, M>(r);
+    return P(r);
   } else {
     const auto S = c.S(q);
     if constexpr (!has_E) {
       const matrix<T, M, M> G = (S.transpose() * S).template cast<T>();
-      return vecN<T, M>(ldlt_factor<T, M>(G, "SᵀS").solve(r));
+      return P(ldlt_factor<T, M>(G, "SᵀS").solve(r));
     } else {
       const matrix<T, M, M> G = (S.transpose() * c.E(q)).template cast<T>();
       // The actuators must produce every admissible motion: SᵀE invertible, and well enough
@@ -124,7 +125,7 @@ auto solve_StE(const C& c, const Eigen::MatrixBase<Q>& q, R r) {
            << kappa << "): the actuators (E) cannot produce every admissible motion (S)";
         throw numerical_error(os.str());
       }
-      return vecN<T, M>(Eigen::PartialPivLU<matrix<T, M, M>>(G).solve(r));
+      return P(Eigen::PartialPivLU<matrix<T, M, M>>(G).solve(r));
     }
   }
 }
@@ -250,8 +251,8 @@ auto nh_pipeline(const chain<S, N>& ch, const C& c, rne_options o, Out out) {
     return compose(std::move(out), rne(ch, o), resize_fn<N>{}, lift(c));
 }
 
-/// Whether inverse_dynamics over a run-time-sized chain of model scalar S can take the
-/// call (q, η, η̇) on stack scratch: a constraint that lifts into given storage (lift_into),
+/// Whether inverse_dynamics over a chain of model scalar S can take the call (q, η, η̇) on
+/// stack scratch: a constraint that lifts into given storage (lift_into),
 /// projects with the lift's memo (St_times) and has SᵀS = I and no E, and a state whose
 /// scalar T the model's promotes to itself (double on double, dual or interval on double).
 template <class S, class C, class Q, class E, class ED>
@@ -263,12 +264,17 @@ constexpr bool fusable_inverse_dynamics() {
     using T = promote_t<promote_t<promote_t<typename constraint_scalar<C>::type, typename Q::Scalar>, typename E::Scalar>,
                         typename ED::Scalar>;
     using Mp = Eigen::Map<vecN<T, dynamic>>;
+    // Compile-time sized, only for a floating-point state: for double it removes the stage
+    // values' copies (store-forwarding stalls), but duals and intervals ran 25–35 % slower on
+    // the scratch maps than through the composition (bench_scalar, 2026-11-24).
     return std::is_same_v<promote_t<S, T>, T> && C::orthonormal_S && !requires(const C& c, const Q& q) { c.E(q); } &&
+           (C::n_at_compile_time == dynamic || std::is_floating_point_v<T>) &&
            requires(const C& c, const Q& q, const E& e, const ED& ed, Mp& m) { c.St_times(m, c.lift_into(q, e, ed, m, m)); };
   }
 }
 
-/// inverse_dynamics over a run-time-sized chain: the composition project ∘ rne ∘ lift itself
+/// inverse_dynamics (chain and constraint both run-time sized, or both of one compile-time
+/// size): the composition project ∘ rne ∘ lift itself
 /// (it derives from it: the same stages, and every call form the composition has), except
 /// that the call (q, η, η̇), where the constraint allows (fusable_inverse_dynamics), runs
 /// the same three stages with ξ's q̇, q̈ and v in stack scratch instead of three heap
@@ -299,8 +305,13 @@ struct scratch_inverse_dynamics : Composed {
                         typename ED::Scalar>;
     check_reduced_state(c, q, eta, eta_dot);  // the lift's checks
     const int n = c.dof();
-    small_buffer<T, dynamic, 256> qd_store(n), v_store(n);  // beyond 256 joints, on the heap
-    Eigen::Map<vecN<T, dynamic>> qd(qd_store.data(), n), v(v_store.data(), n);
+    constexpr int NC = C::n_at_compile_time;
+    // Run-time sized: on the stack up to 256 joints, beyond on the heap. Compile-time sized:
+    // on the stack, and q̇, q̈, v never move between stages (a fixed-size Eigen "move" is a
+    // copy, and a vector load of just-stored scalars stalls store-to-load forwarding).
+    using buffer = std::conditional_t<NC == dynamic, small_buffer<T, dynamic, 256>, small_buffer<T, NC>>;
+    buffer qd_store(n), v_store(n);
+    Eigen::Map<vecN<T, NC>> qd(qd_store.data(), n), v(v_store.data(), n);
     const auto memo = c.lift_into(q, eta, eta_dot, qd, v);  // q̈ into v's storage
     r.overwrite_qdd(q, qd, v);                               // v over q̈
     return c.St_times(v, memo);
@@ -311,7 +322,7 @@ struct scratch_inverse_dynamics : Composed {
 template <class S, int N, class C>
 auto inverse_dynamics(const chain<S, N>& ch, const C& c, rne_options o = {}) {
   auto id = detail::nh_pipeline(ch, c, o, project(c));
-  if constexpr (N == dynamic && C::n_at_compile_time == dynamic)
+  if constexpr (N == C::n_at_compile_time)
     return detail::scratch_inverse_dynamics<decltype(id), S, C>(std::move(id));
   else
     return id;
