@@ -2,12 +2,17 @@
 /// nhdyn's benchmarks (Google Benchmark). Names pair up for scripts/perf_table.py:
 ///   rne/<model>/{nhdyn, nhdyn_fixed, kdl}       holonomic inverse dynamics vs Orocos KDL
 ///   nh_id/<model>/{rne, rne_fixed, lagrange}    nonholonomic inverse dynamics vs projected E–L
+///   nh_pair/<model>/{fixed, run_time}           nh id and the holonomic rne at the lifted state,
+///                                               timed in alternating blocks (counter `ratio`)
 ///   scene/<model>/<variant>                     "model only what a scene requires"
 ///   nh_inertia/<model>/{crba, rne_columns}      M_η = SᵀMS two ways
 /// Every case checks its answer once, untimed, against an independent computation (KDL, the
 /// Lagrangian, the run-time-sized variant) and aborts on disagreement; every case reports
 /// `allocs_per_call`, the heap allocations of one call (counted by alloc_counter.cpp).
 #include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdint>
 
 #include <cstdio>
 #include <cstdlib>
@@ -61,6 +66,45 @@ void add(const std::string& name, F f) {
 template <class V>
 void opaque(V& v) {
   benchmark::DoNotOptimize(v);
+}
+
+/// Registers name → a paired measurement of two calls: blocks of 16 calls of a, then 16 of b
+/// (the order swapped every iteration), each block timed by the steady clock, inside one
+/// benchmark. On a machine whose speed drifts (a shared VM: per-case CV of 10–25 % between
+/// separately run benchmarks), both sides of the ratio then see the same microseconds.
+/// Counters: ratio = time(b) / time(a), a_ns and b_ns per call.
+template <class A, class B>
+void add_paired(const std::string& name, A a, B b) {
+  auto fa = std::make_shared<A>(std::move(a));
+  auto fb = std::make_shared<B>(std::move(b));
+  benchmark::RegisterBenchmark(name.c_str(), [fa, fb](benchmark::State& st) {
+    using clock = std::chrono::steady_clock;
+    constexpr int block = 16;
+    clock::duration ta{}, tb{};
+    std::int64_t calls = 0;
+    bool a_first = true;
+    const auto run = [](auto& f, clock::duration& t) {
+      const auto t0 = clock::now();
+      for (int i = 0; i < block; ++i) f();
+      t += clock::now() - t0;
+    };
+    for (auto _ : st) {
+      if (a_first) {
+        run(*fa, ta);
+        run(*fb, tb);
+      } else {
+        run(*fb, tb);
+        run(*fa, ta);
+      }
+      a_first = !a_first;
+      calls += block;
+    }
+    const double sa = std::chrono::duration<double, std::nano>(ta).count();
+    const double sb = std::chrono::duration<double, std::nano>(tb).count();
+    st.counters["ratio"] = sb / sa;
+    st.counters["a_ns"] = sa / double(calls);
+    st.counters["b_ns"] = sb / double(calls);
+  });
 }
 
 // ---------------------------------------------------------------- issue 2: rne vs KDL
@@ -132,6 +176,40 @@ void register_nh(const std::string& model, const chain<double>& cd) {
     auto tau = idf(qf, ef, edf);
     benchmark::DoNotOptimize(tau);
   });
+  // nh_pair/<model>/{fixed, run_time}: a = the holonomic rne of the same chain at the lifted
+  // state ξ = lift(ζ), b = the nonholonomic inverse dynamics at ζ, paired (add_paired).
+  {
+    const auto lifted = nhdyn::lift(cond)(z.q, z.eta, z.eta_dot);
+    const state xi{lifted.q, lifted.qd, lifted.qdd};
+    const nhdyn::vecN<double, N> xq = xi.q, xqd = xi.qd, xqdd = xi.qdd;
+    auto rd = nhdyn::rne(cd);
+    auto rf = nhdyn::rne(cf);
+    agree(nhdyn::apply_St(cond, z.q, rd(xi.q, xi.qd, xi.qdd)), tau_d, 1e-14, "nh_pair/" + model + ": Sᵀ rne(lift) vs nh");
+    add_paired(
+        "nh_pair/" + model + "/fixed",
+        [rf, xq, xqd, xqdd]() mutable {
+          opaque(xq), opaque(xqd), opaque(xqdd);
+          auto v = rf(xq, xqd, xqdd);
+          benchmark::DoNotOptimize(v);
+        },
+        [idf, qf, ef, edf]() mutable {
+          opaque(qf), opaque(ef), opaque(edf);
+          auto tau = idf(qf, ef, edf);
+          benchmark::DoNotOptimize(tau);
+        });
+    add_paired(
+        "nh_pair/" + model + "/run_time",
+        [rd, xi]() mutable {
+          opaque(xi.q), opaque(xi.qd), opaque(xi.qdd);
+          auto v = rd(xi.q, xi.qd, xi.qdd);
+          benchmark::DoNotOptimize(v);
+        },
+        [idd, z]() mutable {
+          opaque(z.q), opaque(z.eta), opaque(z.eta_dot);
+          auto tau = idd(z.q, z.eta, z.eta_dot);
+          benchmark::DoNotOptimize(tau);
+        });
+  }
   add("nh_id/" + model + "/lagrange", [el, z]() mutable {
     opaque(z.q), opaque(z.eta), opaque(z.eta_dot);
     auto tau = el(z.q, z.eta, z.eta_dot);

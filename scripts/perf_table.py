@@ -38,6 +38,9 @@ SCENE_VARIANTS = [
 TARGET_FIXED, TARGET_DYN, TARGET_NH = 0.25, 0.35, 1.3
 
 
+PAIRED = {}  # nh_pair/<model>/<size> → median over repetitions of time(nh) / time(rne)
+
+
 def load(path):
     with open(path) as f:
         data = json.load(f)
@@ -48,6 +51,8 @@ def load(path):
             med[name] = b["cpu_time"] * {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[b["time_unit"]]
             if "allocs_per_call" in b:
                 allocs[name] = b["allocs_per_call"]
+            if "ratio" in b:  # a paired measurement (nh_pair/…): the median of its ratio counter
+                PAIRED[name] = b["ratio"]
             reps[name] = b.get("repetitions", 1)
     if not med:
         sys.exit("perf_table.py: no median aggregates in %s (run with --benchmark_repetitions)" % path)
@@ -131,23 +136,33 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
     out.append("### Nonholonomic inverse dynamics: rne against the holonomic rne and projected Euler–Lagrange (issue 3)\n")
     out.append("Holonomic = `rne/<model>/nhdyn*` on the same chain without the constraint; "
                "nh = `nh_id/<model>/rne*` = project ∘ rne ∘ lift; E–L = `nh_id/<model>/lagrange`.\n")
-    out.append("| model | n | holonomic fixed | nh fixed | nh / holonomic (fixed) | holonomic run-time | "
-               "nh run-time | nh / holonomic (run-time) | E–L | E–L / nh run-time | allocations nh (run-time, fixed) |")
-    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
-    worst_nh_f = worst_nh_d = 0.0
+    out.append("Paired = `nh_pair/<model>/{fixed,run_time}`: the holonomic rne at the lifted state ξ = lift(ζ) and "
+               "nh at ζ timed in alternating blocks of 16 calls inside one benchmark (median over the "
+               "repetitions of the ratio of their summed times); the other ratios divide medians of "
+               "separately run benchmarks.\n")
+    out.append("| model | n | holonomic fixed | nh fixed | nh / holonomic (fixed) | paired (fixed) | holonomic run-time | "
+               "nh run-time | nh / holonomic (run-time) | paired (run-time) | E–L | E–L / nh run-time | "
+               "allocations nh (run-time, fixed) |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+    worst_nh_f = worst_nh_d = worst_pf = worst_pd = 0.0
     for m in NH_MODELS:
         hf, nf = g(f"rne/{m}/nhdyn_fixed"), g(f"nh_id/{m}/rne_fixed")
         hd, nd = g(f"rne/{m}/nhdyn"), g(f"nh_id/{m}/rne")
+        pf, pd = PAIRED.get(f"nh_pair/{m}/fixed"), PAIRED.get(f"nh_pair/{m}/run_time")
         el = g(f"nh_id/{m}/lagrange")
         worst_nh_f = max(worst_nh_f, ratio(nf, hf) or 0)
         worst_nh_d = max(worst_nh_d, ratio(nd, hd) or 0)
-        out.append(f"| {m} | {DOF[m]} | {ns(hf)} | {ns(nf)} | {r2(ratio(nf, hf))} | {ns(hd)} | {ns(nd)} | "
-                   f"{r2(ratio(nd, hd))} | {ns(el)} | {ratio(el, nd):.0f} | "
+        worst_pf = max(worst_pf, pf or 0)
+        worst_pd = max(worst_pd, pd or 0)
+        out.append(f"| {m} | {DOF[m]} | {ns(hf)} | {ns(nf)} | {r2(ratio(nf, hf))} | {r2(pf)} | {ns(hd)} | {ns(nd)} | "
+                   f"{r2(ratio(nd, hd))} | {r2(pd)} | {ns(el)} | {ratio(el, nd):.0f} | "
                    f"{al(allocs.get(f'nh_id/{m}/rne'))}, {al(allocs.get(f'nh_id/{m}/rne_fixed'))} |")
     out.append("")
-    out.append(f"- Target nh ≤ {TARGET_NH}× holonomic rne of the same chain: compile-time sized, worst "
-               f"**{worst_nh_f:.2f}** — {'met' if worst_nh_f <= TARGET_NH else 'NOT met'}; run-time sized, "
-               f"worst **{worst_nh_d:.2f}** — {'met' if worst_nh_d <= TARGET_NH else 'NOT met'}.")
+    verdict = lambda x: "met" if 0 < x <= TARGET_NH else "NOT met"
+    out.append(f"- Target nh ≤ {TARGET_NH}× holonomic rne of the same chain, judged on the paired measurement: "
+               f"compile-time sized, worst **{worst_pf:.2f}** — {verdict(worst_pf)}; run-time sized, worst "
+               f"**{worst_pd:.2f}** — {verdict(worst_pd)}. Ratios of separately run medians: worst "
+               f"{worst_nh_f:.2f} (fixed) and {worst_nh_d:.2f} (run-time).")
     arms = [DOF[m] for m in NH_MODELS if m.startswith("ddrive")]
     for label, key in (("holonomic rne (fixed)", "rne/{}/nhdyn_fixed"), ("nh rne (fixed)", "nh_id/{}/rne_fixed"),
                        ("nh rne (run-time)", "nh_id/{}/rne"), ("projected E–L", "nh_id/{}/lagrange")):

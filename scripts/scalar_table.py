@@ -35,7 +35,7 @@ SCALARS = [
     ("boost_interval", "boost_interval, interval model"),
 ]
 JACOBIANS = [
-    ("dual", "duals: `inverse_dynamics_linearizer` (built once; 11 dual directions, the 2 vanishing columns skipped)"),
+    ("dual", "duals: `inverse_dynamics_linearizer` (built once; 6 dual directions along q₄, q₅, η, the 3 base columns that vanish by symmetry skipped, ∂τ/∂η̇ = M_η by CRBA)"),
     ("dual_all_columns", "duals: all 13 columns seeded (`jacobian` of the pipeline)"),
     ("dual_oneshot", "duals: `linearize_inverse_dynamics` (builds the pipeline in every call)"),
     ("autodiff", "Eigen AutoDiffScalar<Matrix<double,13,1>>"),
