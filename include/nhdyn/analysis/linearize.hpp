@@ -172,7 +172,7 @@ bool heading_turn_is_symmetry(const chain<S, N>& ch, const C& c, const rne_optio
       return a.cross(b).norm() <= tol * a.norm() * b.norm();
     };
     if (std::abs(ax.dot(ah)) > tol || std::abs(ay.dot(ah)) > tol || std::abs(ax.dot(ay)) > tol) return false;
-    if ((double(c.heading_sign) * ax.cross(ay) - ah).norm() > tol) return false;
+    if ((value_of(c.heading_sign) * ax.cross(ay) - ah).norm() > tol) return false;
     for (int j = 0; j < h; ++j)
       if (j != c.x && j != c.y && !parallel(axis[std::size_t(j)], ah)) return false;
     const Eigen::Vector3d g = ch.gravity().template cast<double>();
