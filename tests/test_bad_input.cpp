@@ -116,6 +116,75 @@ TEST_CASE("bad input: NaN and Inf in a state are errors naming the entry, never 
   CHECK_THAT(message_of<input_error>([&] { k.jacobian(z, -1); }), Contains("link index -1"));
 }
 
+TEST_CASE("bad input: a non-finite entry the result does not depend on is reported all the same") {
+  // rne reads neither q nor q̇ of the joints before the first revolute one (a mobile base's
+  // x and y: they only translate), and nothing of links after the last one with inertia can
+  // reach v: NaN there gave a finite, plausible v. Every entry of every input, NaN or Inf,
+  // must be an input_error naming it — rne on paper5 and on a base with a prismatic lift
+  // joint and a massless tip link, and the nonholonomic inverse dynamics (fixed and
+  // run-time sized, heading sin/cos shared with rne or not) naming q, eta, eta_dot.
+  const auto p5 = presets::paper5_chain<double>();
+  std::vector<nhdyn::link<double>> L{p5[0], p5[1]};
+  nhdyn::link<double> lift_joint;
+  lift_joint.joint = joint_type::prismatic;
+  L.push_back(lift_joint);
+  for (int i = 2; i < 5; ++i) L.push_back(p5[i]);
+  nhdyn::link<double> tip;  // massless
+  tip.a = 0.1;
+  L.push_back(tip);
+  const chain<double> lifted(L, p5.gravity(), "base, lift, arm, massless tip");
+  for (const double bad : {nan_, inf_, -inf_}) {
+    for (const auto& ch : {p5.dynamic_size(), lifted}) {
+      const int n = ch.dof();
+      const VectorXd z = VectorXd::Constant(n, 0.2);
+      for (int i = 0; i < n; ++i) {
+        const std::string at = "[" + std::to_string(i) + "] is not finite";
+        CHECK_THAT(message_of<input_error>([&] { rne(ch)(with(z, i, bad), z, z); }), Contains("q" + at));
+        CHECK_THAT(message_of<input_error>([&] { rne(ch)(z, with(z, i, bad), z); }), Contains("qd" + at));
+        CHECK_THAT(message_of<input_error>([&] { rne(ch)(z, z, with(z, i, bad)); }), Contains("qdd" + at));
+      }
+      const int heading = n == 5 ? 2 : 3;
+      for (const double offset : {0.0, 0.3}) {
+        const differential_drive<double> c(n, 0, 1, heading, offset, -1.0);
+        const auto id = inverse_dynamics(ch, c);
+        const VectorXd e = VectorXd::Constant(n - 1, -0.1);
+        for (int i = 0; i < n; ++i)
+          CHECK_THAT(message_of<input_error>([&] { id(with(z, i, bad), e, e); }),
+                     Contains("q[" + std::to_string(i) + "] is not finite"));
+        for (int i = 0; i < n - 1; ++i) {
+          CHECK_THAT(message_of<input_error>([&] { id(z, with(e, i, bad), e); }),
+                     Contains("eta[" + std::to_string(i) + "] is not finite"));
+          CHECK_THAT(message_of<input_error>([&] { id(z, e, with(e, i, bad)); }),
+                     Contains("eta_dot[" + std::to_string(i) + "] is not finite"));
+        }
+      }
+    }
+    {  // Without velocity terms rne reads no q̇: η is still checked.
+      const auto ch = p5.dynamic_size();
+      const auto id = inverse_dynamics(ch, differential_drive<double>(5, 0, 1, 2, 0.0, -1.0), rne_options{true, false});
+      const VectorXd z = VectorXd::Constant(5, 0.2), e = VectorXd::Constant(4, -0.1);
+      for (int i = 0; i < 4; ++i)
+        CHECK_THAT(message_of<input_error>([&] { id(z, with(e, i, bad), e); }),
+                   Contains("eta[" + std::to_string(i) + "] is not finite"));
+    }
+    const auto r = presets::paper5<double>();
+    const auto id = inverse_dynamics(r.chain, r.constraint);
+    const Eigen::Matrix<double, 5, 1> q = Eigen::Matrix<double, 5, 1>::Constant(0.2);
+    const Eigen::Matrix<double, 4, 1> e = Eigen::Matrix<double, 4, 1>::Constant(-0.1);
+    for (int i = 0; i < 5; ++i) {
+      Eigen::Matrix<double, 5, 1> qb = q;
+      qb(i) = bad;
+      CHECK_THAT(message_of<input_error>([&] { id(qb, e, e); }), Contains("q[" + std::to_string(i) + "] is not finite"));
+    }
+    for (int i = 0; i < 4; ++i) {
+      Eigen::Matrix<double, 4, 1> eb = e;
+      eb(i) = bad;
+      CHECK_THAT(message_of<input_error>([&] { id(q, eb, e); }), Contains("eta[" + std::to_string(i) + "] is not finite"));
+      CHECK_THAT(message_of<input_error>([&] { id(q, e, eb); }), Contains("eta_dot[" + std::to_string(i) + "] is not finite"));
+    }
+  }
+}
+
 TEST_CASE("bad input: finite inputs whose result overflows are a numerical_error, not Inf") {
   const auto ch = two_links();
   const VectorXd z = VectorXd::Zero(2);

@@ -243,6 +243,41 @@ TEST_CASE("inverse_dynamics, compile-time sized: the stack-scratch call is proje
   }
 }
 
+TEST_CASE("inverse_dynamics: the heading's sin/cos taken with rne's joint angles is lift's own, bit for bit") {
+  // For a floating-point state the lift runs inside rne, after its joint angles
+  // (stages.hpp, lift_prelude): when ψ = sign·q_h + offset equals sign·θ_h exactly
+  // (offset = sign·θ⁰_h) ψ's sin/cos are the heading joint's own, otherwise one more angle
+  // in rne's batch. Either way the composition's numbers: heading joints with θ⁰ = 0 and
+  // 0.7, offsets equal to sign·θ⁰ and not, and headings up to 1e6 rad.
+  const auto p5 = nhdyn::presets::paper5_chain<double>();
+  std::vector<nhdyn::link<double>> links;
+  for (int i = 0; i < 5; ++i) links.push_back(p5[i]);
+  links[2].theta = 0.7;
+  const nhdyn::chain<double> turned(links, p5.gravity(), "paper5, heading theta0 = 0.7");
+  struct layout {
+    double theta0, offset, sign;
+  };
+  rng R;
+  for (const layout L : {layout{0.0, 0.0, -1.0}, layout{0.0, 0.0, 1.0}, layout{0.0, 0.3, -1.0}, layout{0.7, -0.7, -1.0},
+                         layout{0.7, 0.7, 1.0}, layout{0.7, 0.7, -1.0}, layout{0.7, 0.0, 1.0}}) {
+    const auto& ch = L.theta0 == 0.0 ? p5 : turned.fixed<5>();
+    const nhdyn::differential_drive<double, 5> c(5, 0, 1, 2, L.offset, L.sign);
+    const auto chd = ch.dynamic_size();
+    const nhdyn::differential_drive<double> cd(5, 0, 1, 2, L.offset, L.sign);
+    const auto id = nhdyn::inverse_dynamics(ch, c);
+    const auto idd = nhdyn::inverse_dynamics(chd, cd);
+    const auto by_hand = nhdyn::lift(c) | nhdyn::rne(ch) | nhdyn::project(c);
+    for (int k = 0; k < 200; ++k) {
+      Eigen::Matrix<double, 5, 1> q = R.vec(5, 3.0);
+      if (k % 4 == 0) q(2) = R.vec(1, 1e6)(0);  // a heading far from 0 (the exactly summed angle)
+      const Eigen::Matrix<double, 4, 1> eta = R.vec(4, 2.0), etad = R.vec(4, 2.0);
+      const Eigen::Matrix<double, 4, 1> tau = by_hand(q, eta, etad);
+      REQUIRE(Eigen::Matrix<double, 4, 1>(id(q, eta, etad)) == tau);
+      REQUIRE(Vec(idd(Vec(q), Vec(eta), Vec(etad))) == Vec(tau));
+    }
+  }
+}
+
 TEST_CASE("differential_drive: bad parameters are rejected with a clear error") {
   using dd = nhdyn::differential_drive<double>;
   const auto msg = [](auto f) {

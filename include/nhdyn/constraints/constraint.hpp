@@ -131,11 +131,12 @@ struct differential_drive {
   /// turned by it, as for a joint's θ⁰ + q (detail/dh.hpp); with offset 0 nothing is done.
   template <class T>
   detail::sin_cos<T> sincos_psi(const T& qh) const {
-    const T a = T(heading_sign * qh), b = T(forward_offset);  // heading_sign = ±1: a is exact
-    const T sum = a + b;
-    auto p = detail::sincos_of(sum);
-    detail::correct_angle_sum(a, b, sum, p.c, p.s);
-    return p;
+    return detail::sincos_of_sum(heading_angle(qh));
+  }
+  /// ψ as the sum (heading_sign·q_h, forward_offset) whose sin/cos sincos_psi takes.
+  template <class T>
+  detail::angle_sum<T> heading_angle(const T& qh) const {
+    return {T(heading_sign * qh), T(forward_offset)};  // heading_sign = ±1: exact
   }
 
   template <class Q>
@@ -312,6 +313,22 @@ struct differential_drive {
   detail::sin_cos<T> lift_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                                const Eigen::MatrixBase<ED>& eta_dot, Eigen::MatrixBase<QDo>& qd,
                                Eigen::MatrixBase<QDDo>& qdd) const {
+    return lift_into(eta, eta_dot, qd, qdd, sincos_psi(T(q(heading))));
+  }
+  /// The angle whose sin/cos lift_into needs (ψ), for a caller that has it computed with
+  /// others (inverse_dynamics: with rne's joint angles), and lift_into with that sin/cos.
+  /// lift_angle_form: ψ = sign·q_j + offset for joint j (when the chain's θ_j = θ⁰_j + q_j
+  /// has θ⁰_j·sign = offset, ψ = sign·θ_j and its sin/cos are the joint's own).
+  template <class T, class Q>
+  detail::angle_sum<T> lift_angle(const Eigen::MatrixBase<Q>& q) const {
+    return heading_angle(T(q(heading)));
+  }
+  detail::joint_angle_form<Sc> lift_angle_form() const { return {heading, heading_sign, forward_offset}; }
+  template <class E, class ED, class QDo, class QDDo, class T = typename QDo::Scalar>
+    requires std::is_same_v<T, typename QDDo::Scalar>
+  detail::sin_cos<T> lift_into(const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
+                               Eigen::MatrixBase<QDo>& qd, Eigen::MatrixBase<QDDo>& qdd,
+                               const detail::sin_cos<T>& p) const {
     const int lo = std::min(x, y), hi = std::max(x, y);
     for (int j = 0, c = 0; j < n; ++j)
       if (j != lo && j != hi) {
@@ -321,7 +338,6 @@ struct differential_drive {
       } else if (j == lo) {
         ++c;
       }
-    const auto p = sincos_psi(T(q(heading)));
     const T v = T(eta(v_slot())), vd = T(eta_dot(v_slot()));
     const T wv = T(heading_sign * qd(heading)) * v;  // ψ̇ v
     qd(x) = p.c * v;

@@ -176,11 +176,35 @@ void correct_angle_sums(const Links& L, const Q& q, int n, T* c, T* s) {
   }
 }
 
+/// An angle given as the sum a + b, whose sin/cos are those of the exact sum (as a joint's
+/// θ⁰ + q; correct_angle_sum): e.g. a mobile base's heading ψ = ±q_h + offset.
+template <class T>
+struct angle_sum {
+  T a, b;
+};
+/// An angle as a joint's: ψ = sign·q_joint + offset (sign ±1).
+template <class S>
+struct joint_angle_form {
+  int joint;
+  S sign, offset;
+};
+/// sin/cos of a + b as the joint angles get them: sincos_of of the rounded sum, then turned
+/// by its rounding error. joint_angles' batch gives the same numbers for its extra angle.
+template <class T>
+sin_cos<T> sincos_of_sum(const angle_sum<T>& x) {
+  const T sum = x.a + x.b;
+  auto p = sincos_of(sum);
+  correct_angle_sum(x.a, x.b, sum, p.c, p.s);
+  return p;
+}
+
 /// cos θ_i and sin θ_i of links 0…n−1 at q (θ_i = θ_i⁰ + q_i for a revolute joint, θ_i⁰
 /// for a prismatic one), all at once: for double by sincos_reduced, otherwise by the
-/// scalar's own cos and sin.
+/// scalar's own cos and sin. With `extra`, also cos/sin of that angle, into c[n] and s[n]
+/// (c and s then hold n + 1): a stage around the kernel (the nonholonomic lift's heading)
+/// gets its sin/cos from the same batch, the same numbers as sincos_of_sum gives.
 template <class T, int N, class Links, class Q>
-void joint_angles(const Links& L, const Q& q, int n, T* c, T* s) {
+void joint_angles(const Links& L, const Q& q, int n, T* c, T* s, const angle_sum<T>* extra = nullptr) {
   using std::cos;
   using std::sin;
   const auto theta = [&](int i) {
@@ -188,15 +212,21 @@ void joint_angles(const Links& L, const Q& q, int n, T* c, T* s) {
     return k.revolute ? T(T(k.th0) + T(q(i))) : T(k.th0);
   };
   if constexpr (std::is_same_v<T, double>) {
-    small_buffer<double, N> th(n);
+    const int total = n + (extra ? 1 : 0);
+    small_buffer<double, N == dynamic ? dynamic : N + 1> th(total);
     bool small = true;
     for (int i = 0; i < n; ++i) {
       th[i] = theta(i);
       small = small & (std::abs(th[i]) <= 1e5);  // false for NaN
     }
+    if (extra) {
+      th[n] = extra->a + extra->b;
+      small = small & (std::abs(th[n]) <= 1e5);
+    }
     if (small) {
-      sincos_reduced(th.data(), s, c, n);
+      sincos_reduced(th.data(), s, c, total);
       correct_angle_sums(L, q, n, c, s);
+      if (extra) correct_angle_sum(extra->a, extra->b, th[n], c[n], s[n]);
       return;
     }
   }
@@ -213,6 +243,11 @@ void joint_angles(const Links& L, const Q& q, int n, T* c, T* s) {
     }
   }
   correct_angle_sums(L, q, n, c, s);
+  if (extra) {
+    const auto p = sincos_of_sum(*extra);
+    c[n] = p.c;
+    s[n] = p.s;
+  }
 }
 
 /// v in frame i−1 → frame i: R_iᵀ v = Rx(α)ᵀ Rz(θ)ᵀ v.

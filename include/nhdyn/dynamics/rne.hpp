@@ -33,17 +33,52 @@ struct rne_scratch {
   v3<T> F, Nn;  // net force on link i and net moment about o_i, frame i
 };
 
+/// What rne_kernel runs between its joint angles and its passes: nothing (this), or a
+/// stage that writes the q̇ and q̈ the passes read from the kernel's joint angles (the
+/// nonholonomic lift of inverse_dynamics, constraints/stages.hpp, whose heading is one of
+/// them or one more taken in their batch). Such a prelude p has
+///   `bool p.extra_angle(angle_sum<T>& a)`: whether it needs one more angle (then a is it);
+///   `p(const T* c, const T* s)`: cos and sin of the n joint angles, and at n the extra one's.
+struct no_prelude {};
+/// A prelude whose call is another's (rne_fn: the prelude's own, then a check).
+template <class P, class F>
+struct prelude_with {
+  const P& p;
+  const F& f;
+  template <class A>
+  bool extra_angle(A& a) const {
+    return p.extra_angle(a);
+  }
+  template <class T>
+  void operator()(const T* c, const T* s) const {
+    f(c, s);
+  }
+};
+
 /// The recursion. Gravity and Velocity are compile-time so that a call that needs
 /// neither pays for neither. Written on plain scalars (detail::v3): this is the hot loop
 /// of the library, and the benchmark (docs/performance.md) chose this form.
 /// The n results go to `tau` (any writable vector of T, already of size n). `tau` may be the
 /// storage of `qdd`: q̈_i is read only in the forward pass, τ_i written only in the backward pass.
-template <bool Gravity, bool Velocity, class T, int N, class Links, class Q, class QD, class QDD, class Tau>
-void rne_kernel(const Links& L, const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd, Tau& tau) {
+/// `prelude` (no_prelude above) runs after the joint angles, before q̇ and q̈ are read.
+template <bool Gravity, bool Velocity, class T, int N, class Links, class Q, class QD, class QDD, class Tau,
+          class Prelude = no_prelude>
+void rne_kernel(const Links& L, const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd, Tau& tau,
+                const Prelude& prelude = {}) {
   const int n = static_cast<int>(q.size());
+  constexpr bool has_prelude = !std::is_same_v<Prelude, no_prelude>;
   small_buffer<rne_scratch<T>, N> ws(n);
-  small_buffer<T, N> cs(n), sn(n);  // cos θ_i, sin θ_i
-  joint_angles<T, N>(L, q, n, cs.data(), sn.data());
+  // cos θ_i, sin θ_i (and the prelude's angle at n)
+  constexpr int NA = N == dynamic ? dynamic : N + int(has_prelude);
+  small_buffer<T, NA> cs(n + int(has_prelude)), sn(n + int(has_prelude));
+  if constexpr (has_prelude) {
+    angle_sum<T> extra{T(0), T(0)};
+    const bool more = prelude.extra_angle(extra);
+    joint_angles<T, N>(L, q, n, cs.data(), sn.data(), more ? &extra : nullptr);
+    prelude(static_cast<const T*>(cs.data()), static_cast<const T*>(sn.data()));
+  } else {
+    joint_angles<T, N>(L, q, n, cs.data(), sn.data());
+  }
   const T zero(0);
   v3<T> w{zero, zero, zero}, dw{zero, zero, zero};  // ω_i, ω̇_i  (frame i)
   v3<T> acc = Gravity ? v3<T>{-g.x(), -g.y(), -g.z()} : v3<T>{zero, zero, zero};  // a_{o_i} − g
@@ -206,7 +241,11 @@ class rne_fn : public stage_tag {
   static constexpr int size_at_compile_time = N;
 
   explicit rne_fn(const chain<S, N>& c, rne_options o = {})
-      : links_(detail::make_dh_links(c)), g_(c.gravity()), n_(c.dof()), opt_(o) {}
+      : links_(detail::make_dh_links(c)), g_(c.gravity()), n_(c.dof()), opt_(o) {
+    while (prefix_ < n_ && !links_[static_cast<std::size_t>(prefix_)].revolute) ++prefix_;
+    for (int i = 0; i < n_; ++i)
+      if (links_[static_cast<std::size_t>(i)].has_inertia) tail_ = i + 1;
+  }
 
   int dof() const { return n_; }
   rne_options options() const { return opt_; }
@@ -222,6 +261,7 @@ class rne_fn : public stage_tag {
     detail::check_size(q, n_, "q");
     detail::check_size(qd, n_, "qd");
     detail::check_size(qdd, n_, "qdd");
+    check_unseen(q, qd, qdd);
     vecN<T, N> v(n_);
     run(q, qd, qdd, v);
     detail::check_result(v, q, qd, qdd, "rne");
@@ -265,11 +305,13 @@ class rne_fn : public stage_tag {
   /// v = rne(q, q̇, q̈) written over q̈ (`qdd_then_v`: any writable Eigen vector of the
   /// result's scalar, e.g. a map of stack scratch), checked as the pipeline form. What the
   /// run-time-sized inverse_dynamics calls to stay as allocation-free as the fixed-size one.
-  template <class Q, class QD, class V>
+  /// With a prelude (detail::no_prelude): what writes q̇ and q̈ runs inside the kernel, after
+  /// its joint angles, and gets the sin/cos of its own angle from their batch.
+  template <class Q, class QD, class V, class Prelude = detail::no_prelude>
     requires std::is_same_v<typename V::Scalar, promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>>
-  void overwrite_qdd(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
-                     Eigen::MatrixBase<V>& qdd_then_v) const {
-    run_checked(q.derived(), qd.derived(), qdd_then_v.derived(), qdd_then_v.derived());
+  void overwrite_qdd(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, Eigen::MatrixBase<V>& qdd_then_v,
+                     const Prelude& prelude = {}) const {
+    run_checked(q.derived(), qd.derived(), qdd_then_v.derived(), qdd_then_v.derived(), prelude);
   }
 
   /// The same algorithm with other options.
@@ -289,14 +331,25 @@ class rne_fn : public stage_tag {
   }
   /// v = rne(q, q̇, q̈) into v, which may be q̈'s storage. Then q̈ may be gone (v in its place),
   /// so a non-finite result names q or q̇ when they are the cause, and otherwise says "q̈ or
-  /// overflow". Not checking q̈ before is measurable (4 ns of a 115 ns paper5 call); inside
-  /// inverse_dynamics, lift has checked η̇ already.
-  template <class Qx, class QDx, class QDDx, class V>
-  void run_checked(const Qx& q, const QDx& qd, const QDDx& qdd, V& v) const {
+  /// overflow". Not checking q̈ before is measurable (4 ns of a 115 ns paper5 call); the
+  /// entries v does not depend on are checked before (check_unseen).
+  template <class Qx, class QDx, class QDDx, class V, class Prelude = detail::no_prelude>
+  void run_checked(const Qx& q, const QDx& qd, const QDDx& qdd, V& v, const Prelude& prelude = {}) const {
     detail::check_size(q, n_, "q");
     detail::check_size(qd, n_, "qd");
     detail::check_size(qdd, n_, "qdd");
-    run(q, qd, qdd, v);
+    if constexpr (std::is_same_v<Prelude, detail::no_prelude>) {
+      check_unseen(q, qd, qdd);
+      run(q, qd, qdd, v);
+    } else {
+      // q̇ and q̈ are the prelude's to write: their unseen entries are checked after it.
+      check_unseen(q, std::false_type{}, std::false_type{});
+      const auto checked = [&](const auto* c, const auto* s) __attribute__((always_inline)) {
+        prelude(c, s);
+        check_unseen(std::false_type{}, qd, qdd);
+      };
+      run(q, qd, qdd, v, detail::prelude_with<Prelude, decltype(checked)>{prelude, checked});
+    }
     for (Eigen::Index i = 0; i < v.size(); ++i)
       if (!is_finite_scalar(v(i))) [[unlikely]] {
         detail::check_finite(q, "q");
@@ -305,16 +358,41 @@ class rne_fn : public stage_tag {
                               " is not finite: qdd has a non-finite entry, or the computation overflowed");
       }
   }
-  template <class Q, class QD, class QDD, class V>
-  void run(const Q& q, const QD& qd, const QDD& qdd, V& v) const {
+  /// Checks the inputs that cannot reach v, so that no non-finite input goes unreported: a
+  /// non-finite input that v depends on makes v non-finite, and the result check names it.
+  /// Not read by the kernel: q and q̇ of the translating prefix (and q̇ at all without
+  /// velocity terms); reaching no mass: q, q̇, q̈ of the links after the last with inertia.
+  /// paper5: q₁, q₂, q̇₁, q̇₂ (its x and y) — before this, a NaN there gave a finite v.
+  /// An argument std::false_type: that vector is not checked here.
+  template <class Qx, class QDx, class QDDx>
+  void check_unseen(const Qx& q, const QDx& qd, const QDDx& qdd) const {
+    const auto check = [](const auto& v, int begin, int end, const char* what) {
+      if (begin < end && !detail::finite_range(v, begin, end)) [[unlikely]]
+        detail::check_finite(v, what);  // names the first non-finite entry (it is one)
+    };
+    if constexpr (!std::is_same_v<Qx, std::false_type>) {
+      check(q, 0, prefix_, "q");
+      check(q, tail_, n_, "q");
+    }
+    if constexpr (!std::is_same_v<QDx, std::false_type>) {
+      if (opt_.velocity) {
+        check(qd, 0, prefix_, "qd");
+        check(qd, tail_, n_, "qd");
+      }
+    }
+    if constexpr (!std::is_same_v<QDDx, std::false_type>) check(qdd, tail_, n_, "qdd");
+  }
+
+  template <class Q, class QD, class QDD, class V, class Prelude = detail::no_prelude>
+  void run(const Q& q, const QD& qd, const QDD& qdd, V& v, const Prelude& prelude = {}) const {
     using T = typename V::Scalar;
     const vec3<T> g = g_.template cast<T>();
     if (opt_.gravity) {
-      opt_.velocity ? detail::rne_kernel<true, true, T, N>(links_, g, q, qd, qdd, v)
-                    : detail::rne_kernel<true, false, T, N>(links_, g, q, qd, qdd, v);
+      opt_.velocity ? detail::rne_kernel<true, true, T, N>(links_, g, q, qd, qdd, v, prelude)
+                    : detail::rne_kernel<true, false, T, N>(links_, g, q, qd, qdd, v, prelude);
     } else {
-      opt_.velocity ? detail::rne_kernel<false, true, T, N>(links_, g, q, qd, qdd, v)
-                    : detail::rne_kernel<false, false, T, N>(links_, g, q, qd, qdd, v);
+      opt_.velocity ? detail::rne_kernel<false, true, T, N>(links_, g, q, qd, qdd, v, prelude)
+                    : detail::rne_kernel<false, false, T, N>(links_, g, q, qd, qdd, v, prelude);
     }
   }
 
@@ -322,6 +400,8 @@ class rne_fn : public stage_tag {
   vec3<S> g_;
   int n_;
   rne_options opt_;
+  int prefix_ = 0;  // links before the first revolute joint (they only translate)
+  int tail_ = 0;    // one past the last link with inertia
 };
 
 /// rne over chain c: `rne(c)(q, qd, qdd)`.

@@ -192,19 +192,38 @@ inline void check_size(const V& v, int n, const char* what) {
   os << what << "[" << i << "] is not finite (" << x << ")";
   throw input_error(os.str());
 }
+/// Whether v's entries begin…end−1 are all finite (false for NaN and ±Inf). For float and
+/// double one pass without a branch per entry: x·0 is 0 for a finite x and NaN otherwise, so
+/// their sum is 0 exactly when every entry is finite (one fused multiply-add each; under
+/// -ffast-math, which would fold x·0 to 0, the exponent bits instead).
+template <class V>
+inline bool finite_range(const V& v, Eigen::Index begin, Eigen::Index end) {
+  using T = typename V::Scalar;
+  if constexpr (std::is_same_v<T, double> || std::is_same_v<T, float>) {
+#ifndef __FAST_MATH__
+    T z(0);
+    for (Eigen::Index i = begin; i < end; ++i) z += T(v(i)) * T(0);
+    return z == T(0);
+#else
+    using U = std::conditional_t<std::is_same_v<T, double>, std::uint64_t, std::uint32_t>;
+    constexpr U exp_mask = std::is_same_v<T, double> ? U(0x7ff0000000000000ULL) : U(0x7f800000U);
+    bool bad = false;
+    for (Eigen::Index i = begin; i < end; ++i) bad |= (std::bit_cast<U>(T(v(i))) & exp_mask) == exp_mask;
+    return !bad;
+#endif
+  } else {
+    for (Eigen::Index i = begin; i < end; ++i)
+      if (!is_finite_scalar(v(i))) return false;
+    return true;
+  }
+}
 /// Throws input_error naming the first non-finite entry of v. For float and double the
-/// common case is one pass over the exponent bits.
+/// common case is one pass without a branch per entry.
 template <class V>
 inline void check_finite(const V& v, const char* what) {
   using T = typename V::Scalar;
   if constexpr (std::is_same_v<T, double> || std::is_same_v<T, float>) {
-    // An IEEE number is finite unless its exponent bits are all ones: integer ORs with a
-    // one-cycle dependency, no floating-point chain.
-    using U = std::conditional_t<std::is_same_v<T, double>, std::uint64_t, std::uint32_t>;
-    constexpr U exp_mask = std::is_same_v<T, double> ? U(0x7ff0000000000000ULL) : U(0x7f800000U);
-    bool bad = false;
-    for (Eigen::Index i = 0; i < v.size(); ++i) bad |= (std::bit_cast<U>(T(v(i))) & exp_mask) == exp_mask;
-    if (!bad) [[likely]]
+    if (finite_range(v, 0, v.size())) [[likely]]
       return;
   }
   if constexpr (requires(const T& x) { x.value(); x.derivatives(); x.derivative(0); }) {
