@@ -222,6 +222,8 @@ void joint_angles(const Links& L, const Q& q, int n, T* c, T* s, const angle_sum
     if (extra) {
       th[n] = extra->a + extra->b;
       small = small & (std::abs(th[n]) <= 1e5);
+    } else if constexpr (N != dynamic) {
+      th[n] = 0.0;  // the spare slot of a fixed-size buffer (unread; GCC cannot tell)
     }
     if (small) {
       sincos_reduced(th.data(), s, c, total);
