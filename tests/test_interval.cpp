@@ -129,3 +129,23 @@ TEST_CASE("interval: nhdyn::interval and Boost.Interval agree to a few ulps on a
   CHECK(!nhdyn::isfinite(e));
   CHECK(!nhdyn::isfinite(e * a + 1.0));
 }
+
+TEMPLATE_TEST_CASE("interval: comparisons are Boost's 'certainly': decided ones true or false, undecided ones throw",
+                   "[interval]", nhdyn::interval, nhdyn::boost_interval) {
+  using I = TestType;
+  const I a(1.0, 2.0), b(3.0, 4.0), c(1.5, 3.5), p(2.0, 2.0);
+  CHECK(a < b);
+  CHECK_FALSE(b < a);
+  CHECK(b > a);
+  CHECK(a <= b);
+  CHECK(b >= a);
+  CHECK_FALSE(a == b);  // disjoint: certainly different
+  CHECK(a != b);
+  CHECK(p == I(2.0, 2.0));  // equal points: certainly equal
+  CHECK_FALSE(p != I(2.0, 2.0));
+  using boost::numeric::interval_lib::comparison_error;
+  CHECK_THROWS_AS(a < c, comparison_error);  // overlapping: undecided
+  CHECK_THROWS_AS(a == c, comparison_error);
+  CHECK_THROWS_AS(a != c, comparison_error);
+  CHECK_THROWS_AS(a == a, comparison_error);  // a non-degenerate interval against itself
+}

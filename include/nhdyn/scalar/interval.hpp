@@ -166,8 +166,10 @@ class boost_interval {
   friend bool operator>(const boost_interval& a, const boost_interval& b) { return a.x_ > b.x_; }
   friend bool operator<=(const boost_interval& a, const boost_interval& b) { return a.x_ <= b.x_; }
   friend bool operator>=(const boost_interval& a, const boost_interval& b) { return a.x_ >= b.x_; }
-  friend bool operator==(const boost_interval& a, const boost_interval& b) { return a.x_ == b.x_; }
-  friend bool operator!=(const boost_interval& a, const boost_interval& b) { return a.x_ != b.x_; }
+  // == and != call Boost's member operators by name: C++20's reversed candidates make
+  // `a.x_ == b.x_` ambiguous in clang's eyes (-Wambiguous-reversed-operator); same function.
+  friend bool operator==(const boost_interval& a, const boost_interval& b) { return a.x_.operator==(b.x_); }
+  friend bool operator!=(const boost_interval& a, const boost_interval& b) { return a.x_.operator!=(b.x_); }
 
   friend boost_interval sin(const boost_interval& a) { return boost_interval(boost::numeric::sin(a.x_)); }
   friend boost_interval cos(const boost_interval& a) { return boost_interval(boost::numeric::cos(a.x_)); }
@@ -278,8 +280,8 @@ class interval {
   friend bool operator>(const interval& a, const interval& b) { return a.boost() > b.boost(); }
   friend bool operator<=(const interval& a, const interval& b) { return a.boost() <= b.boost(); }
   friend bool operator>=(const interval& a, const interval& b) { return a.boost() >= b.boost(); }
-  friend bool operator==(const interval& a, const interval& b) { return a.boost() == b.boost(); }
-  friend bool operator!=(const interval& a, const interval& b) { return a.boost() != b.boost(); }
+  friend bool operator==(const interval& a, const interval& b) { return a.boost().operator==(b.boost()); }
+  friend bool operator!=(const interval& a, const interval& b) { return a.boost().operator!=(b.boost()); }
 
   /// (sin a, cos a) together, from one evaluation of the kernel at each end (see the file
   /// comment for how they are enclosed).
