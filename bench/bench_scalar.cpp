@@ -7,6 +7,10 @@
 //   scalar/jacobian/paper5/{dual,dual_oneshot,dual_all_columns,autodiff,central}: the full
 //       ∂τ/∂ζ (4×13) of paper5 (dual: inverse_dynamics_linearizer built once; oneshot:
 //       linearize_inverse_dynamics per call; all_columns: jacobian() seeding all 13);
+//   scalar/fd_linearize/paper5/{double_fd,ift,ift_oneshot,all_duals}: one double
+//       nh_forward_dynamics call, and A, B of its linearisation by forward_dynamics_linearizer
+//       built once (implicit function theorem on the linearizer's ∂τ/∂(q, η, η̇)), by
+//       linearize_forward_dynamics (builds it per call), and by duals along all of (q, η, τ);
 //   scalar/bounds/paper5/split:k: interval enclosure over a state box, counter width.
 // chain24 is paper5's differential-drive base carrying a 21-joint random arm (bench/models.hpp).
 // The 50-digit reference is cross-checked at start-up: rne₅₀ against the CRBA path
@@ -271,7 +275,79 @@ void bm_jacobian_central(benchmark::State& st) {
   }
 }
 
-// ---- interval width vs bisection depth vs time
+// ---- the forward dynamics' linearisation (A 9×9, B 9×4) of paper5
+/// τ at each state (the forward dynamics' input), from the double inverse dynamics.
+const std::vector<V4>& tau_set() {
+  static const std::vector<V4> t = [] {
+    const auto id = nhdyn::inverse_dynamics(paper5(), constraint<5>());
+    const auto& s = state_set<5>();
+    std::vector<V4> out;
+    for (std::size_t k = 0; k < s.q.size(); ++k) out.push_back(id(s.q[k], s.eta[k], s.etad[k]));
+    return out;
+  }();
+  return t;
+}
+/// One double nh_forward_dynamics call (what the linearisations are compared with).
+void bm_fd_double(benchmark::State& st) {
+  const auto fd = nhdyn::nh_forward_dynamics(paper5(), constraint<5>());
+  const auto& s = state_set<5>();
+  const auto& t = tau_set();
+  std::size_t k = 0;
+  for (auto _ : st) {
+    auto ed = fd(s.q[k], s.eta[k], t[k]);
+    benchmark::DoNotOptimize(ed);
+    k = (k + 1) & 63;
+  }
+}
+/// forward_dynamics_linearizer (built once, as the double forward dynamics is): the
+/// inverse-dynamics Jacobian and the implicit function theorem.
+void bm_fd_linearize(benchmark::State& st) {
+  const nhdyn::forward_dynamics_linearizer lin(paper5(), constraint<5>());
+  const auto& s = state_set<5>();
+  const auto& t = tau_set();
+  std::size_t k = 0;
+  for (auto _ : st) {
+    auto ss = lin(s.q[k], s.eta[k], t[k]);
+    benchmark::DoNotOptimize(ss);
+    k = (k + 1) & 63;
+  }
+}
+/// linearize_forward_dynamics: the same, building the linearizer in every call.
+void bm_fd_linearize_oneshot(benchmark::State& st) {
+  const auto c = constraint<5>();
+  const auto& s = state_set<5>();
+  const auto& t = tau_set();
+  std::size_t k = 0;
+  for (auto _ : st) {
+    auto ss = nhdyn::linearize_forward_dynamics(paper5(), c, s.q[k], s.eta[k], t[k]);
+    benchmark::DoNotOptimize(ss);
+    k = (k + 1) & 63;
+  }
+}
+/// Every column of (q, η, τ) seeded through the forward dynamics (dual<double, 13>).
+void bm_fd_linearize_all_duals(benchmark::State& st) {
+  const auto c = constraint<5>();
+  const auto fd = nhdyn::nh_forward_dynamics(paper5(), c);
+  const auto f = [&](const auto& z) {
+    using D = typename std::decay_t<decltype(z)>::Scalar;
+    Eigen::Matrix<D, 9, 1> out;
+    out << nhdyn::apply_S(c, z.template head<5>(), z.template segment<4>(5)),
+        fd(z.template head<5>(), z.template segment<4>(5), z.template tail<4>());
+    return out;
+  };
+  const auto& s = state_set<5>();
+  const auto& t = tau_set();
+  std::size_t k = 0;
+  for (auto _ : st) {
+    V13 z;
+    z << s.q[k], s.eta[k], t[k];
+    auto J = nhdyn::jacobian(f, z);
+    benchmark::DoNotOptimize(J);
+    k = (k + 1) & 63;
+  }
+}
+
+// ---- interval width vs bisection depth vs time// ---- interval width vs bisection depth vs time
 void bm_bounds(benchmark::State& st) {
   const int split = static_cast<int>(st.range(0));
   const auto c = constraint<5>();
@@ -333,6 +409,10 @@ const bool registered = [] {
   benchmark::RegisterBenchmark("scalar/jacobian/paper5/dual_all_columns", bm_jacobian_dual_all_columns);
   benchmark::RegisterBenchmark("scalar/jacobian/paper5/autodiff", bm_jacobian_autodiff);
   benchmark::RegisterBenchmark("scalar/jacobian/paper5/central", bm_jacobian_central);
+  benchmark::RegisterBenchmark("scalar/fd_linearize/paper5/double_fd", bm_fd_double);
+  benchmark::RegisterBenchmark("scalar/fd_linearize/paper5/ift", bm_fd_linearize);
+  benchmark::RegisterBenchmark("scalar/fd_linearize/paper5/ift_oneshot", bm_fd_linearize_oneshot);
+  benchmark::RegisterBenchmark("scalar/fd_linearize/paper5/all_duals", bm_fd_linearize_all_duals);
   for (int k : {0, 2, 4, 6, 8, 10})
     benchmark::RegisterBenchmark(("scalar/bounds/paper5/split:" + std::to_string(k)).c_str(), bm_bounds)->Arg(k);
   if (!check_reference()) std::fprintf(stderr, "WARNING: the 50-digit reference failed its cross-check\n");

@@ -100,6 +100,17 @@ def main():
             continue
         target = ("≤ 8: **met**" if x / d5 <= 8 else "≤ 8: **NOT met**") if key == "dual" else ""
         lines.append(f"| {label} | {fmt_ns(x)} | {x / d5:.3g} | {target} |")
+    fdd = med.get("scalar/fd_linearize/paper5/double_fd")
+    ift = med.get("scalar/fd_linearize/paper5/ift")
+    ift1 = med.get("scalar/fd_linearize/paper5/ift_oneshot")
+    alld = med.get("scalar/fd_linearize/paper5/all_duals")
+    if fdd and ift and ift1 and alld:
+        lines += ["", "Forward-dynamics linearisation of paper5, A (9 × 9) and B (9 × 4) of ẋ = f(x, τ), x = (q, η); "
+                      f"one double `nh_forward_dynamics` call = **{fmt_ns(fdd)}** in this run.", "",
+                  "| method | CPU per (A, B) | × one double forward dynamics |", "|---|---|---|",
+                  f"| `forward_dynamics_linearizer` (built once): the linearizer's ∂τ/∂(q, η, η̇) at (q, η, fd(q, η, τ)), implicit function theorem | {fmt_ns(ift)} | {ift / fdd:.3g} |",
+                  f"| `linearize_forward_dynamics` (the same, built in every call) | {fmt_ns(ift1)} | {ift1 / fdd:.3g} |",
+                  f"| duals: all 13 columns of (q, η, τ) seeded through `nh_forward_dynamics` | {fmt_ns(alld)} | {alld / fdd:.3g} |"]
     iv = t("nh_id", "paper5", "interval_state")
     if iv is not None:
         lines += ["", f"Intervals, paper5, double model with an interval state box (what `torque_bounds` over states does): "

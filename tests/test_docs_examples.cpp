@@ -496,6 +496,9 @@ TEST_CASE("docs/api.md §10: the linearizer, the state-space linearisation and t
   const auto J = lin(q, eta, eta_dot);  // J.J: 4 × 13; J.dq(), J.deta(), J.deta_dot() (= M_η)
   // ẋ = f(x, u) with x = (q, η), u = τ: A = ∂f/∂x (9 × 9), B = ∂f/∂u (9 × 4).
   const auto ss = nhdyn::linearize_forward_dynamics(robot.chain, robot.constraint, q, eta, tau);
+  // …or built once for many states (MPC, gain scheduling): the same A, B.
+  const nhdyn::forward_dynamics_linearizer fdlin(robot.chain, robot.constraint);
+  const auto ss2 = fdlin(q, eta, tau);
   // Every τ for every state in a box (±0.01 about the state), rounded outward; 2 bisections.
   nhdyn::box<5> Q;
   nhdyn::box<4> H, HD;
@@ -515,6 +518,8 @@ TEST_CASE("docs/api.md §10: the linearizer, the state-space linearisation and t
     const vec4 d = (id(qp, eta, eta_dot) - id(qm, eta, eta_dot)) / (2 * h);
     CHECK(rel(J.dq().col(j), d) < 1e-7);
   }
+  CHECK(ss2.A == ss.A);
+  CHECK(ss2.B == ss.B);
   // B = [0; M_η⁻¹] (τ enters η̇ only, through M_η⁻¹ since E = S, SᵀS = I).
   CHECK(ss.B.topRows(5).cwiseAbs().maxCoeff() == 0.0);
   CHECK(relm(ss.B.bottomRows(4), Eigen::Matrix4d(fd.reduced_inertia(q).inverse())) < 1e-12);

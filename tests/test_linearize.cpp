@@ -129,6 +129,82 @@ TEST_CASE("linearize: A and B of paper5's forward dynamics match 50-digit finite
   CHECK(rel_err(ss.B.bottomRows(4) * Me, Eigen::Matrix4d::Identity()) < 1e-12);
 }
 
+TEST_CASE("linearize: A and B from the inverse-dynamics Jacobian equal every column seeded through the forward dynamics") {
+  // linearize_forward_dynamics takes A, B from the linearizer's ∂τ/∂(q, η, η̇) at
+  // (q, η, fd(q, η, τ)) by the implicit function theorem. The reference here differentiates
+  // the forward dynamics itself: duals along all of (q, η, τ) through nh_forward_dynamics
+  // (CRBA, LDLᵀ and rne in duals) — a different computation, equal to rounding. paper5
+  // (fixed size), the same run-time sized, a base with a 4-joint arm and gravity tilted
+  // (no symmetry: the heading column computed), and a constraint with SᵀS ≠ I and E ≠ S.
+  const auto reference = [](const auto& ch, const auto& c, const Eigen::VectorXd& q, const Eigen::VectorXd& eta,
+                            const Eigen::VectorXd& tau) {
+    const int n = c.dof(), m = c.m();
+    const auto fd = nhdyn::nh_forward_dynamics(ch, c);
+    const auto f = [&](const auto& x) {
+      using D = typename std::decay_t<decltype(x)>::Scalar;
+      Eigen::Matrix<D, Eigen::Dynamic, 1> out(n + m);
+      out << nhdyn::apply_S(c, x.head(n), x.segment(n, m)), fd(x.head(n), x.segment(n, m), x.tail(m));
+      return out;
+    };
+    Eigen::VectorXd x(n + 2 * m);
+    x << q, eta, tau;
+    return Eigen::MatrixXd(nhdyn::jacobian(f, x));
+  };
+  const auto check = [&](const auto& ch, const auto& c, const Eigen::VectorXd& q, const Eigen::VectorXd& eta,
+                         const Eigen::VectorXd& tau) {
+    const int n = c.dof(), m = c.m();
+    const auto ss = nhdyn::linearize_forward_dynamics(ch, c, q, eta, tau);
+    const Eigen::MatrixXd J = reference(ch, c, q, eta, tau);
+    INFO("A:\n" << ss.A << "\nreference:\n" << J.leftCols(n + m));
+    CHECK(rel_err(ss.A, J.leftCols(n + m)) < 1e-12);
+    CHECK(rel_err(ss.B, J.rightCols(m)) < 1e-12);
+    CHECK(ss.B.topRows(n).cwiseAbs().maxCoeff() == 0.0);
+  };
+  const auto r = nhdyn::presets::paper5();
+  const auto id = nhdyn::inverse_dynamics(r.chain, r.constraint);
+  for (double s : {1.0, -0.4, 2.0}) {
+    const V5 q = s * q0;
+    const V4 eta = s * eta0, tau = id(q, eta, V4(s * etad0));
+    const auto ss = nhdyn::linearize_forward_dynamics(r.chain, r.constraint, q, eta, tau);
+    const Eigen::MatrixXd J = reference(r.chain, r.constraint, q, eta, tau);
+    CHECK(rel_err(ss.A, J.leftCols(9)) < 1e-12);
+    CHECK(rel_err(ss.B, J.rightCols(4)) < 1e-12);
+    check(r.chain.dynamic_size(), nhdyn::differential_drive<double>(5, 0, 1, 2, 0.0, -1.0), q, eta, tau);
+  }
+  {  // a 4-joint arm on paper5's base, gravity tilted
+    std::vector<nhdyn::link<double>> L(r.chain.begin(), r.chain.end());
+    L.push_back(L[3]);
+    L.push_back(L[4]);
+    const nhdyn::chain<double> arm(L, Eigen::Vector3d(-9.7, 1.5, 0.8), "tilted base + 4 joints");
+    const nhdyn::differential_drive<double> dd(7, 0, 1, 2, 0.2, -1.0);
+    Eigen::VectorXd q(7), eta(6), etad(6);
+    q << q0, 0.3, -0.6;
+    eta << eta0, 0.4, -0.2;
+    etad << etad0, -0.3, 0.6;
+    check(arm, dd, q, eta, nhdyn::inverse_dynamics(arm, dd)(q, eta, etad));
+  }
+  {  // SᵀS ≠ I, E ≠ S (as in the linearizer's test below)
+    const auto c = r.constraint;
+    const auto scaledS = [c](const auto& q) {
+      using T = typename std::decay_t<decltype(q)>::Scalar;
+      Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> S = c.S(q);
+      for (int j = 0; j < 4; ++j) S.col(j) *= T(0.5 + 0.7 * j);
+      return S;
+    };
+    const auto inputE = [c, scaledS](const auto& q) {
+      using T = typename std::decay_t<decltype(q)>::Scalar;
+      Eigen::MatrixXd G(4, 4);
+      G << 1.0, 0.2, 0, 0, -0.1, 0.9, 0, 0.3, 0, 0, 1.2, 0.1, 0.2, 0, 0, 0.8;
+      return Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>(scaledS(q) * G.cast<T>());
+    };
+    const auto userE = nhdyn::make_constraint(
+        5, 1, [c](const auto& q) { return c.A(q); }, scaledS, nullptr, inputE);
+    const auto dyn = r.chain.dynamic_size();
+    const Eigen::VectorXd q = q0, eta = eta0;
+    check(dyn, userE, q, eta, nhdyn::inverse_dynamics(dyn, userE)(q, eta, Eigen::VectorXd(etad0)));
+  }
+}
+
 TEST_CASE("linearize: a holonomic chain gives x = (q, qd), A = [0 I; dqdd/dq dqdd/dqd], B = [0; M^-1]") {
   const auto p = nhdyn::presets::puma560();
   using V6 = Eigen::Matrix<double, 6, 1>;

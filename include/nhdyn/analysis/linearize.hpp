@@ -11,7 +11,8 @@
 ///   ζ = (q, η, η̇) and the blocks ∂τ/∂q, ∂τ/∂η, ∂τ/∂η̇ (= M_η when E = S);
 ///   `inverse_dynamics_linearizer(chain, c)` is the same as a function object built once.
 /// - `linearize_forward_dynamics(chain, c, q, η, τ)`: ẋ = f(x, u) with x = (q, η),
-///   f = (S(q)η, η̇(q, η, τ)), u = τ → A = ∂f/∂x, B = ∂f/∂u. For a holonomic chain,
+///   f = (S(q)η, η̇(q, η, τ)), u = τ → A = ∂f/∂x, B = ∂f/∂u (from ∂τ/∂ζ by the implicit
+///   function theorem); `forward_dynamics_linearizer(chain, c)` built once. For a holonomic chain,
 ///   `linearize_forward_dynamics(chain, q, q̇, τ)`: x = (q, q̇), f = (q̇, q̈).
 /// - Parameter sensitivities: build the model from dual parameters inside f, e.g.
 ///       jacobian([&](const auto& p) {
@@ -24,6 +25,7 @@
 ///   I_zz,i) for every link i (columns link by link).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <limits>
 #include <type_traits>
 #include <vector>
@@ -290,33 +292,66 @@ struct state_space {
   Eigen::Matrix<T, NX, NU> B;
 };
 
-/// x = (q, η), f = (S(q)η, η̇), u = τ for a constrained robot (paper5: 9 states, 4 inputs).
+/// x = (q, η), f = (S(q)η, η̇), u = τ for a constrained robot (paper5: 9 states, 4 inputs):
+/// A = ∂f/∂x, B = ∂f/∂u, built once for a chain and constraint (as inverse_dynamics_linearizer)
+/// and evaluated at any (q, η, τ).
+///
+/// From the inverse dynamics, not by differentiating the forward dynamics: η̇ = fd(q, η, τ)
+/// is the solution of id(q, η, η̇) = τ, so (implicit function theorem) with K = ∂τ/∂η̇ =
+/// (SᵀE)⁻¹M_η, ∂η̇/∂(q, η) = −K⁻¹ ∂τ/∂(q, η) and ∂η̇/∂τ = K⁻¹ — the linearizer's Jacobian
+/// at (q, η, fd(q, η, τ)) (duals along q and η only, K from CRBA) and one m×m LU, as
+/// Pinocchio's ABA derivatives come from the RNEA ones. The kinematic rows: ∂(Sη)/∂η = S,
+/// ∂(Sη)/∂q by duals of the S-product alone, ∂(Sη)/∂τ = 0. The forward dynamics' own
+/// checks apply (a non-positive-definite or ill-conditioned M_η is a numerical_error).
+template <class S, int N, class C>
+class forward_dynamics_linearizer {
+ public:
+  forward_dynamics_linearizer(const chain<S, N>& ch, const C& c, rne_options o = {})
+      : fd_(nh_forward_dynamics(ch, c, o)), id_(ch, c, o), c_(c) {}
+
+  template <class Q, class E, class TAU>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
+                  const Eigen::MatrixBase<TAU>& tau) const {
+    constexpr int M = C::m_at_compile_time;
+    constexpr int NX = (N == dynamic || M == dynamic) ? dynamic : N + M;
+    const int n = c_.dof(), m = c_.m();
+    if constexpr (N == dynamic) detail::check_size(q, n, "q");
+    detail::check_size(eta, m, "eta");
+    detail::check_size(tau, m, "tau");
+    using T = typename Q::Scalar;
+    const vecN<T, N> qt = q.template cast<T>();
+    const vecN<T, M> et = eta.template cast<T>();
+    const vecN<T, M> eta_dot = fd_(qt, et, tau.template cast<T>());
+    const auto J = id_(qt, et, eta_dot);
+    const Eigen::PartialPivLU<Eigen::Matrix<T, M, M>> K(Eigen::Matrix<T, M, M>(J.deta_dot()));
+    state_space<T, NX, M> out;
+    out.A.setZero(n + m, n + m);
+    out.B.setZero(n + m, m);
+    out.A.block(0, 0, n, n) = jacobian(
+        [&](const auto& qz) {
+          using D = typename std::decay_t<decltype(qz)>::Scalar;
+          return vecN<D, N>(apply_S(c_, qz, et.template cast<D>()));
+        },
+        qt);
+    out.A.block(0, n, n, m) = c_.S(qt).template cast<T>();
+    out.A.block(n, 0, m, n + m) = -K.solve(J.J.leftCols(n + m));
+    out.B.bottomRows(m) = K.inverse();
+    return out;
+  }
+
+ private:
+  nh_forward_dynamics_fn<S, N, C> fd_;
+  inverse_dynamics_linearizer<S, N, C> id_;
+  C c_;
+};
+
+/// The same for one (q, η, τ) (builds the linearizer for this one call; keep a
+/// forward_dynamics_linearizer to evaluate many states).
 template <class S, int N, class C, class Q, class E, class TAU>
 auto linearize_forward_dynamics(const chain<S, N>& ch, const C& c, const Eigen::MatrixBase<Q>& q,
                                 const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                                 rne_options o = {}) {
-  constexpr int M = C::m_at_compile_time;
-  constexpr int Z = detail::stacked<N, M>;
-  constexpr int NX = (N == dynamic || M == dynamic) ? dynamic : N + M;
-  const int n = c.dof(), m = c.m();
-  if constexpr (N == dynamic) detail::check_size(q, n, "q");
-  detail::check_size(eta, m, "eta");
-  detail::check_size(tau, m, "tau");
-  const auto fd = nh_forward_dynamics(ch, c, o);
-  const auto f = [&](const auto& z) {
-    const auto qz = z.head(n);
-    const auto ez = z.segment(n, m);
-    using D = typename std::decay_t<decltype(z)>::Scalar;
-    vecN<D, NX> xdot(n + m);
-    xdot << apply_S(c, qz, ez), fd(qz, ez, z.tail(m));
-    return xdot;
-  };
-  using T = typename Q::Scalar;
-  const auto J = jacobian(f, detail::stack3<Z>(q.template cast<T>(), eta, tau));
-  state_space<T, NX, M> out;
-  out.A = J.leftCols(n + m);
-  out.B = J.rightCols(m);
-  return out;
+  return forward_dynamics_linearizer<S, N, C>(ch, c, o)(q, eta, tau);
 }
 
 /// x = (q, q̇), f = (q̇, q̈), u = τ for a holonomic chain.
