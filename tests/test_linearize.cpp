@@ -33,6 +33,18 @@ double rel_err(const A& a, const B& b) {
   return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
 }
 
+/// S(q) of constraint c with its columns scaled by 0.5, 1.2, 1.9, 2.6 (SᵀS ≠ I), as a
+/// generic function of q for make_constraint.
+template <class C>
+auto scaled_S(const C& c) {
+  return [c](const auto& q) {
+    using T = typename std::decay_t<decltype(q)>::Scalar;
+    Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> S = c.S(q);
+    for (int j = 0; j < 4; ++j) S.col(j) *= T(0.5 + 0.7 * j);
+    return S;
+  };
+}
+
 /// 50-digit central differences of τ(ζ), converted to double.
 Eigen::Matrix<double, 4, 13> mp_reference(const V13& z) {
   const Eigen::Matrix<mp50, 13, 1> zm = z.cast<mp50>();
@@ -185,13 +197,8 @@ TEST_CASE("linearize: A and B from the inverse-dynamics Jacobian equal every col
   }
   {  // SᵀS ≠ I, E ≠ S (as in the linearizer's test below)
     const auto c = r.constraint;
-    const auto scaledS = [c](const auto& q) {
-      using T = typename std::decay_t<decltype(q)>::Scalar;
-      Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> S = c.S(q);
-      for (int j = 0; j < 4; ++j) S.col(j) *= T(0.5 + 0.7 * j);
-      return S;
-    };
-    const auto inputE = [c, scaledS](const auto& q) {
+    const auto scaledS = scaled_S(c);
+    const auto inputE = [scaledS](const auto& q) {
       using T = typename std::decay_t<decltype(q)>::Scalar;
       Eigen::MatrixXd G(4, 4);
       G << 1.0, 0.2, 0, 0, -0.1, 0.9, 0, 0.3, 0, 0, 1.2, 0.1, 0.2, 0, 0, 0.8;
@@ -337,12 +344,7 @@ TEST_CASE("linearize: the linearizer skips only columns that vanish, and the res
   CHECK(rel_err(lu(qd, ed, edd).J, lin(q0, eta0, etad0).J) < 1e-13);
   // SᵀS ≠ I and an input map E ≠ S: ∂τ/∂η̇ = (SᵀE)⁻¹SᵀMS, against every column seeded.
   using MX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic>;
-  const auto scaledS = [c](const auto& q) {
-    using T = typename std::decay_t<decltype(q)>::Scalar;
-    Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> S = c.S(q);
-    for (int j = 0; j < 4; ++j) S.col(j) *= T(0.5 + 0.7 * j);
-    return S;
-  };
+  const auto scaledS = scaled_S(c);
   const auto inputE = [c, scaledS](const auto& q) {
     using T = typename std::decay_t<decltype(q)>::Scalar;
     MX G(4, 4), W(1, 4);
