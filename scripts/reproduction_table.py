@@ -6,7 +6,7 @@
 Reads DIR/summary.json (one entry per run: name, success, max_tail_error [m], steps,
 failure, wall_time_s, cpu_time_s, peak_tau), writes the per-scene and per-run tables between
 the BEGIN/END GENERATED markers of the document, and copies the figures the document shows
-(DIR/paper-circle-{path,error,q}.png, DIR/paper-{factorial,noise}-error.png) into
+(DIR/paper-circle-{path,error,q,tau}.png, DIR/paper-factorial-{error,tau}.png, DIR/paper-noise-error.png) into
 docs/figures/reproduction/. No number in those tables is typed by hand.
 """
 import json
@@ -18,8 +18,8 @@ from datetime import datetime, timezone
 
 BEGIN = "<!-- BEGIN GENERATED: scripts/reproduction_table.py -->"
 END = "<!-- END GENERATED -->"
-FIGURES = ["paper-circle-path.png", "paper-circle-error.png", "paper-circle-q.png",
-           "paper-factorial-error.png", "paper-noise-error.png"]
+FIGURES = ["paper-circle-path.png", "paper-circle-error.png", "paper-circle-q.png", "paper-circle-tau.png",
+           "paper-factorial-error.png", "paper-factorial-tau.png", "paper-noise-error.png"]
 PAPER = {"paper-circle": "(fig. 4–6)", "paper-factorial": "14", "paper-noise": "13"}
 
 

@@ -7,4 +7,4 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DNHDYN_BUILD_TESTS=OFF >/dev/null
 cmake --build build -j"$(nproc)" --target nhdyn_tool
-./build/examples/nhdyn simulate paper --out out/paper
+./build/bin/nhdyn simulate paper --out out/paper

@@ -94,6 +94,10 @@ TEST_CASE("bad input: rne, M(q), bias and forward dynamics reject wrong sizes na
   kinematics<double, 5> k5(p5);
   CHECK_THAT(message_of<input_error>([&] { k5.forward(z4); }), Contains("q has 4"));
   CHECK_THAT(message_of<input_error>([&] { k5.jdot_qdot(z5, z4, 5, vec3<double>::Zero()); }), Contains("qd has 4"));
+  // A short q is reported, not read past its end (it was, before: issue 12).
+  CHECK_THAT(message_of<input_error>([&] { k5.jdot_qdot(z4, z5, 5, vec3<double>::Zero()); }), Contains("q has 4"));
+  CHECK_THAT(message_of<input_error>([&] { k5.jacobian(z6, 5); }), Contains("q has 6"));
+  CHECK_THAT(message_of<input_error>([&] { k5.point(z4, 5); }), Contains("q has 4"));
 }
 
 TEST_CASE("bad input: NaN and Inf in a state are errors naming the entry, never NaN results") {
@@ -110,6 +114,9 @@ TEST_CASE("bad input: NaN and Inf in a state are errors naming the entry, never 
     CHECK_THAT(message_of<input_error>([&] { k.forward(with(z, 0, bad)); }), Contains("q[0]"));
     CHECK_THAT(message_of<input_error>([&] { k.jacobian(with(z, 1, bad), 2); }), Contains("q[1]"));
     CHECK_THAT(message_of<input_error>([&] { k.jdot_qdot(z, with(z, 1, bad), 2); }), Contains("qd[1]"));
+    CHECK_THAT(message_of<input_error>([&] { k.jdot_qdot(with(z, 0, bad), z, 2); }), Contains("q[0]"));
+    CHECK_THAT(message_of<input_error>([&] { k.point(z, 2, vec3<double>(0, bad, 0)); }), Contains("p_i[1]"));
+    CHECK_THAT(message_of<input_error>([&] { k.jacobian(z, 2, vec3<double>(bad, 0, 0)); }), Contains("p_i[0]"));
   }
   kinematics<double> k(ch);
   CHECK_THAT(message_of<input_error>([&] { k.frame(z, 3); }), Contains("link index 3"));
@@ -204,7 +211,11 @@ TEST_CASE("bad input: the nonholonomic stages check sizes and finiteness of q, e
   CHECK_THAT(message_of<input_error>([&] { id(q, e, VectorXd::Zero(3)); }), Contains("eta_dot has 3"));
   CHECK_THAT(message_of<input_error>([&] { fd(q, e, VectorXd::Zero(5)); }), Contains("tau has 5"));
   CHECK_THAT(message_of<input_error>([&] { fd(q, VectorXd::Zero(2), e); }), Contains("eta has 2"));
+  CHECK_THAT(message_of<input_error>([&] { fd.reduced_inertia(VectorXd::Zero(4)); }), Contains("q has 4"));
+  CHECK_THAT(message_of<input_error>([&] { fd.reduced_bias(q, VectorXd::Zero(3)); }), Contains("eta has 3"));
   CHECK_THAT(message_of<input_error>([&] { project(r.constraint)(q, VectorXd::Zero(4)); }), Contains("v has 4"));
+  CHECK_THAT(message_of<input_error>([&] { project(r.constraint)(VectorXd::Zero(3), q); }), Contains("q has 3"));
+  CHECK_THAT(message_of<input_error>([&] { constraint_forces(r.constraint)(VectorXd::Zero(6), q); }), Contains("q has 6"));
   for (const double bad : {nan_, inf_}) {
     CHECK_THAT(message_of<input_error>([&] { id(with(q, 2, bad), e, e); }), Contains("q[2] is not finite"));
     CHECK_THAT(message_of<input_error>([&] { id(q, with(e, 0, bad), e); }), Contains("eta[0] is not finite"));
@@ -212,7 +223,12 @@ TEST_CASE("bad input: the nonholonomic stages check sizes and finiteness of q, e
     CHECK_THAT(message_of<input_error>([&] { fd(q, with(e, 1, bad), e); }), Contains("eta[1] is not finite"));
     CHECK_THAT(message_of<input_error>([&] { fd(with(q, 4, bad), e, e); }), Contains("q[4] is not finite"));
     CHECK_THAT(message_of<input_error>([&] { fd(q, e, with(e, 2, bad)); }), Contains("tau[2] is not finite"));
+    CHECK_THAT(message_of<input_error>([&] { fd.reduced_inertia(with(q, 2, bad)); }), Contains("q[2] is not finite"));
+    CHECK_THAT(message_of<input_error>([&] { fd.reduced_bias(q, with(e, 3, bad)); }), Contains("eta[3] is not finite"));
     CHECK_THAT(message_of<input_error>([&] { lift(r.constraint)(q, e, with(e, 1, bad)); }), Contains("eta_dot[1]"));
+    CHECK_THAT(message_of<input_error>([&] { project(r.constraint)(with(q, 2, bad), q); }), Contains("q[2] is not finite"));
+    CHECK_THAT(message_of<input_error>([&] { project(r.constraint)(q, with(q, 4, bad)); }), Contains("v[4] is not finite"));
+    CHECK_THAT(message_of<input_error>([&] { constraint_forces(r.constraint)(q, with(q, 0, bad)); }), Contains("v[0]"));
   }
   // Constraint and chain that do not match, a bad differential drive.
   CHECK_THAT(message_of<model_error>([&] { nh_forward_dynamics(two_links(), differential_drive<double>(3, 0, 1, 2)); }),

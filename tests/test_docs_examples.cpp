@@ -463,7 +463,7 @@ TEST_CASE("docs/api.md §2: a model read from JSON text gives the pendulum's clo
   // m.chain: chain<double> (run-time size); m.constraint: std::optional<differential_drive<double>>
   const Eigen::VectorXd v = nhdyn::rne(m.chain)(Eigen::VectorXd::Constant(1, 0.4), Eigen::VectorXd::Constant(1, -1.3),
                                                 Eigen::VectorXd::Constant(1, 0.9));
-  const auto p5 = nhdyn::io::load("paper5");  // a preset name, or a file: io::load("examples/paper5.json")
+  const auto p5 = nhdyn::io::load("paper5");  // a preset name, or a file: io::load("examples/models/paper5.json")
   // end snippet
   // A point mass m at the tip of a massless rod l: τ = m l² q̈ + m g l cos q.
   CHECK(v(0) == Approx(2 * 0.7 * 0.7 * 0.9 + 2 * 9.81 * 0.7 * std::cos(0.4)).epsilon(1e-14));

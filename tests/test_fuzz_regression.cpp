@@ -18,8 +18,7 @@ namespace fs = std::filesystem;
 
 namespace {
 std::vector<fs::path> corpus(const std::string& target) {
-  const char* src = std::getenv("NHDYN_SOURCE_DIR");
-  const fs::path dir = fs::path(src ? src : NHDYN_SOURCE_DIR_FALLBACK) / "tests" / "fuzz" / "corpus" / target;
+  const fs::path dir = fs::path(NHDYN_SOURCE_DIR) / "tests" / "fuzz" / "corpus" / target;
   std::vector<fs::path> files;
   if (fs::is_directory(dir))
     for (const auto& e : fs::directory_iterator(dir))

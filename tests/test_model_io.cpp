@@ -17,11 +17,7 @@ using nhdyn::io::json;
 
 namespace {
 
-fs::path source_dir() {
-  const char* s = std::getenv("NHDYN_SOURCE_DIR");
-  REQUIRE(s != nullptr);
-  return s;
-}
+fs::path source_dir() { return NHDYN_SOURCE_DIR; }
 
 std::string read_text(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -84,7 +80,7 @@ std::string load_error(const std::string& text, const std::string& name = "bad.j
   return "";
 }
 
-json paper5_json() { return json::parse(read_text(source_dir() / "examples/paper5.json")); }
+json paper5_json() { return json::parse(read_text(source_dir() / "examples/models/paper5.json")); }
 
 void require_contains(const std::string& msg, std::initializer_list<std::string> parts) {
   INFO("message: " << msg);
@@ -118,8 +114,8 @@ nhdyn::chain<double> random_chain(std::mt19937_64& rng, int n) {
 
 }  // namespace
 
-TEST_CASE("model files: examples/paper5.json loads to the paper5 preset bit for bit, with its constraint") {
-  const auto m = nhdyn::io::load_model(source_dir() / "examples/paper5.json");
+TEST_CASE("model files: examples/models/paper5.json loads to the paper5 preset bit for bit, with its constraint") {
+  const auto m = nhdyn::io::load_model(source_dir() / "examples/models/paper5.json");
   const auto r = nhdyn::presets::paper5<double>();
   require_same_chain(m.chain, r.chain);
   REQUIRE(m.constraint.has_value());
@@ -131,7 +127,7 @@ TEST_CASE("model files: examples/paper5.json loads to the paper5 preset bit for 
 }
 
 TEST_CASE("model files: paper5.json holds paper5.md's numbers, inertias from the box formulas") {
-  const auto ch = nhdyn::io::load_model(source_dir() / "examples/paper5.json").chain;
+  const auto ch = nhdyn::io::load_model(source_dir() / "examples/models/paper5.json").chain;
   const double pi = 3.14159265358979323846;
   using J = nhdyn::joint_type;
   CHECK(ch[0].joint == J::prismatic);
@@ -170,7 +166,7 @@ TEST_CASE("model files: paper5.json holds paper5.md's numbers, inertias from the
   // Products of inertia are zero.
   for (int i = 0; i < 5; ++i) CHECK(ch[i].inertia.isDiagonal(0.0));
   // The constraint: x = q1, y = q2, heading q3, ψ = −q3 (paper5.md's A = [sin q3, cos q3, 0, 0, 0]).
-  const auto c = *nhdyn::io::load_model(source_dir() / "examples/paper5.json").constraint;
+  const auto c = *nhdyn::io::load_model(source_dir() / "examples/models/paper5.json").constraint;
   const Eigen::VectorXd q = (Eigen::VectorXd(5) << 0.1, -0.2, 0.7, 0.3, -0.4).finished();
   const Eigen::MatrixXd A = c.A(q);
   CHECK(A(0, 0) == Approx(std::sin(0.7)).margin(1e-15));
@@ -178,8 +174,8 @@ TEST_CASE("model files: paper5.json holds paper5.md's numbers, inertias from the
   CHECK(A.rightCols(3).isZero(0.0));
 }
 
-TEST_CASE("model files: examples/puma560.json loads to the puma560 preset bit for bit") {
-  const auto m = nhdyn::io::load_model(source_dir() / "examples/puma560.json");
+TEST_CASE("model files: examples/models/puma560.json loads to the puma560 preset bit for bit") {
+  const auto m = nhdyn::io::load_model(source_dir() / "examples/models/puma560.json");
   require_same_chain(m.chain, nhdyn::presets::puma560<double>());
   CHECK_FALSE(m.constraint.has_value());
   CHECK_FALSE(m.chain.validation_policy().triangle_inequality);
@@ -188,7 +184,7 @@ TEST_CASE("model files: examples/puma560.json loads to the puma560 preset bit fo
   CHECK(m.chain[1].a == 0.4318);
   CHECK(m.chain.gravity() == Eigen::Vector3d(0, 0, -9.81));
   // Without the validation switch, the published link 1 is rejected, by name.
-  auto j = json::parse(read_text(source_dir() / "examples/puma560.json"));
+  auto j = json::parse(read_text(source_dir() / "examples/models/puma560.json"));
   j.erase("validation");
   require_contains(load_error(j.dump(2), "puma_strict.json"),
                    {"puma_strict.json", "link 1", "field 'inertia'", "triangle inequality"});
@@ -227,11 +223,11 @@ TEST_CASE("model files: save then load is exact, on random chains and the preset
     nhdyn::io::save_model(m, path);
     require_same_chain(nhdyn::io::load_model(path).chain, m.chain);
     // The shipped file is exactly what saving the preset writes.
-    CHECK(read_text(path) == read_text(source_dir() / "examples" / (name + ".json")));
+    CHECK(read_text(path) == read_text(source_dir() / "examples" / "models" / (name + ".json")));
   }
 }
 
-TEST_CASE("model files: format_number prints 17 significant digits that read back bit for bit") {
+TEST_CASE("model files: format_number prints the shortest decimal that reads back bit for bit") {
   std::mt19937_64 rng(11);
   std::uniform_int_distribution<std::uint64_t> bits;
   int tried = 0;
@@ -244,20 +240,32 @@ TEST_CASE("model files: format_number prints 17 significant digits that read bac
     const std::string s = nhdyn::io::format_number(x);
     const double y = json::parse(s).get<double>();
     REQUIRE(std::memcmp(&x, &y, sizeof x) == 0);
+    // As short as possible: no longer than the shortest %.pg (p = 1…17) that reads back to x
+    // (an independent search; to_chars may write fewer characters still, e.g. "100" for 1e+02).
+    std::size_t shortest = 0;
+    for (int p = 1; p <= 17 && !shortest; ++p) {
+      char buf[40];
+      std::snprintf(buf, sizeof buf, "%.*g", p, x);
+      if (std::strtod(buf, nullptr) == x) shortest = std::strlen(buf);
+    }
+    INFO(s);
+    REQUIRE(s.size() <= shortest);
   }
+  CHECK(nhdyn::io::format_number(-9.81) == "-9.81");
+  CHECK(nhdyn::io::format_number(0.1) == "0.1");
   for (double x : {0.1, 1.0 / 3, 5e-324, 1.7976931348623157e308, -0.0, 0.0, 9.0, -3.0, 1e22, 9007199254740993.0}) {
     const double y = json::parse(nhdyn::io::format_number(x)).get<double>();
     CHECK(std::memcmp(&x, &y, sizeof x) == 0);  // the sign of zero too
   }
   // dump() prints every number this way, and refuses NaN/Inf rather than writing null.
-  CHECK(nhdyn::io::dump(nhdyn::io::ordered_json{{"a", {0.1, -0.0, 2}}}) == R"({"a": [0.10000000000000001, -0.0, 2]})");
+  CHECK(nhdyn::io::dump(nhdyn::io::ordered_json{{"a", {0.1, -0.0, 2}}}) == R"({"a": [0.1, -0.0, 2]})");
   CHECK_THROWS_AS(nhdyn::io::dump(json{{"a", {1.0, std::nan("")}}}), nhdyn::numerical_error);
   CHECK_THROWS_AS(nhdyn::io::format_number(std::numeric_limits<double>::infinity()), nhdyn::numerical_error);
   CHECK_THROWS_AS(nhdyn::io::format_number(std::nan("")), nhdyn::numerical_error);
 }
 
 TEST_CASE("model files: a file loads in other scalar types (long double)") {
-  const auto m = nhdyn::io::load_model<long double>(source_dir() / "examples/paper5.json");
+  const auto m = nhdyn::io::load_model<long double>(source_dir() / "examples/models/paper5.json");
   CHECK(m.chain[2].mass == 9.0L);
   CHECK(m.chain[2].d == static_cast<long double>(0.237));
   CHECK(m.constraint->heading_sign == -1.0L);
@@ -342,7 +350,7 @@ TEST_CASE("model files: a missing, mistyped or misspelled field is an error nami
 }
 
 TEST_CASE("model files: malformed, truncated or overflowing JSON is an error with its line and column") {
-  const std::string good = read_text(source_dir() / "examples/paper5.json");
+  const std::string good = read_text(source_dir() / "examples/models/paper5.json");
   SECTION("truncated in the middle: the line of the end is reported") {
     const auto cut = good.find("\"mass\": 9");
     const std::string text = good.substr(0, cut + 8);
@@ -395,7 +403,7 @@ TEST_CASE("model files: unreadable files and unknown presets are clear errors") 
   require_contains(msg([] { nhdyn::io::load("paper6"); }), {"'paper6'", "no such file", "paper5, puma560"});
   // load() takes a preset name or a path.
   require_same_chain(nhdyn::io::load("puma560").chain, nhdyn::presets::puma560<double>());
-  require_same_chain(nhdyn::io::load((source_dir() / "examples/puma560.json").string()).chain,
+  require_same_chain(nhdyn::io::load((source_dir() / "examples/models/puma560.json").string()).chain,
                      nhdyn::presets::puma560<double>());
 }
 

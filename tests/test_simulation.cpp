@@ -3,6 +3,7 @@
 // expectation, sampled control, seeded noise, failure reporting and the scene format.
 #include <catch2/catch.hpp>
 #include <cstdlib>
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -14,9 +15,11 @@
 using namespace nhdyn;
 
 namespace {
-std::string scene_file(const std::string& name) {
-  const char* src = std::getenv("NHDYN_SOURCE_DIR");
-  return std::string(src ? src : ".") + "/examples/scenes/" + name + ".json";
+std::string scene_file(const std::string& name) { return std::string(NHDYN_SOURCE_DIR) + "/examples/scenes/" + name + ".json"; }
+/// The runs of a shipped scene file; the names it uses are looked up in its own folder.
+std::vector<run_spec> runs_of(const std::string& name) {
+  const auto f = scene::open(scene_file(name));
+  return scene::expand(f.j, f.dirs);
 }
 
 /// paper5, unforced (simulation/free_motion.hpp).
@@ -80,7 +83,7 @@ TEST_CASE("simulation: the integrated base path never slips sideways (ṗ_b · z
 }
 
 TEST_CASE("simulation: paper-circle succeeds with paper5.md's ≈3 mm tail error, the same under rk4 and dopri5") {
-  const auto specs = scene::expand(scene::load(scene_file("paper-circle")));
+  const auto specs = runs_of("paper-circle");
   REQUIRE(specs.size() == 1);
   const auto a = simulate(specs[0]);
   REQUIRE(a.success);
@@ -190,7 +193,7 @@ TEST_CASE("simulation: failing runs are reported as failed with their reason") {
 }
 
 TEST_CASE("scene: the shipped studies expand to paper5.md's designs") {
-  const auto fact = scene::expand(scene::load(scene_file("paper-factorial")));
+  const auto fact = runs_of("paper-factorial");
   REQUIRE(fact.size() == 16);
   std::set<std::array<double, 4>> combos;
   for (const auto& s : fact) {
@@ -202,7 +205,7 @@ TEST_CASE("scene: the shipped studies expand to paper5.md's designs") {
     CHECK(s.sample_rate == 0);
   }
   CHECK(combos.size() == 16);
-  const auto noise = scene::expand(scene::load(scene_file("paper-noise")));
+  const auto noise = runs_of("paper-noise");
   REQUIRE(noise.size() == 16);
   for (std::size_t i = 0; i < 16; ++i) {
     CHECK(noise[i].seed == i + 1);
@@ -211,11 +214,38 @@ TEST_CASE("scene: the shipped studies expand to paper5.md's designs") {
     CHECK(noise[i].plant.mass_factor[2] == 1.1);
     CHECK(noise[i].plant.d3_factor == 1.0);
   }
-  const auto circle = scene::expand(scene::load(scene_file("paper-circle")))[0];
+  const auto circle = runs_of("paper-circle")[0];
   CHECK(circle.reference.omega == 2 * 3.14159265358979323846 / 20);
   CHECK(circle.q0(2) == 3.141592653589793);
   CHECK(circle.gains.K0(1, 1) == 400);
   CHECK(circle.gains.lambda == 0.02);
+}
+
+TEST_CASE("scene: names in a scene file resolve in its own folder, whatever the current folder") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("nhdyn_scene_dirs_" + std::to_string(::getpid()));
+  fs::create_directories(dir / "mine");
+  fs::create_directories(dir / "elsewhere");
+  // A study in its own folder whose base is a scene of that folder, named by name.
+  std::ofstream(dir / "mine" / "short.json") << R"({"name": "short", "duration": 0.5})";
+  std::ofstream(dir / "mine" / "study.json")
+      << R"({"name": "st", "study": {"base": "short", "factors": [{"name": "d", "path": "/duration", "levels": [0.25, 0.75]}]}})";
+  const fs::path before = fs::current_path();
+  fs::current_path(dir / "elsewhere");
+  const auto f = scene::open((dir / "mine" / "study.json").string(), {});
+  const auto runs = scene::expand(f.j, f.dirs);
+  REQUIRE(runs.size() == 2);
+  CHECK(runs[0].duration == 0.25);
+  CHECK(runs[1].name == "st-d_0.75");
+  // A name found nowhere: the error lists the folders looked in.
+  try {
+    scene::open("no-such-scene", {dir / "mine"});
+    FAIL("no error");
+  } catch (const input_error& e) {
+    CHECK_THAT(std::string(e.what()), Catch::Contains("no-such-scene") && Catch::Contains((dir / "mine").string()));
+  }
+  fs::current_path(before);
+  fs::remove_all(dir);
 }
 
 TEST_CASE("scene: unknown or malformed fields are errors naming the field") {

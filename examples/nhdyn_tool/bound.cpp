@@ -2,7 +2,8 @@
 /// `nhdyn bound`: guaranteed enclosures of the torques over boxes of states, by interval
 /// arithmetic with outward rounding (analysis/bounds.hpp). Input bounds are widened by one
 /// ulp (the decimal text may lie between doubles); output bounds are printed so that the
-/// decimal text never narrows them (each bound moved one double outward, then %.17g).
+/// decimal text never narrows them (each bound moved one double outward, then written in the shortest form that reads
+/// back to that double).
 #include <iostream>
 #include <nhdyn/analysis/bounds.hpp>
 #include <nhdyn/nhdyn.hpp>

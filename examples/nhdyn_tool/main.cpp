@@ -14,6 +14,7 @@
   X(simulate)
 
 #include <iostream>
+#include <nhdyn/version.hpp>
 
 #include "tool.hpp"
 
@@ -34,8 +35,9 @@ std::vector<command> registry() {
 
 void print_help(std::ostream& os, const std::vector<command>& cmds) {
   os << "nhdyn: dynamics of manipulators and nonholonomic mobile manipulators on JSON lines\n\n"
-        "Usage: nhdyn <command> [options]\n"
-        "       nhdyn <command> --help     full help of one command\n\n"
+        "Usage: nhdyn <command> [options] [--] [arguments]\n"
+        "       nhdyn <command> --help     full help of one command\n"
+        "       nhdyn --version            the version\n\n"
         "Commands:\n";
   for (const auto& c : cmds) {
     os << "  " << c.name;
@@ -45,10 +47,11 @@ void print_help(std::ostream& os, const std::vector<command>& cmds) {
   os << "\nMODEL is a preset name (";
   const auto names = nhdyn::io::preset_names();
   for (std::size_t i = 0; i < names.size(); ++i) os << (i ? ", " : "") << names[i];
-  os << ") or the path of a JSON model file (docs/model-format.md).\n"
+  os << "), the path of a JSON model file (docs/model-format.md), or the name of a model\n"
+        "shipped in share/nhdyn/models.\n"
         "Line-oriented commands read one JSON object per line on stdin and write one JSON line\n"
         "per input line on stdout, in order; a bad line gets {\"error\": \"line N: ...\"} and the\n"
-        "tool goes on. Numbers are printed with 17 significant digits (round-trip exact).\n"
+        "tool goes on. Numbers are printed in the shortest form that reads back exactly.\n"
         "Exit status: 0 all lines succeeded, 1 some line failed or the model is invalid,\n"
         "2 bad command line.\n\n";
   for (const auto& c : cmds) os << c.usage << '\n';
@@ -64,6 +67,14 @@ int main(int argc, char** argv) {
   }
   if (args[0] == "-h" || args[0] == "--help" || args[0] == "help") {
     print_help(std::cout, cmds);
+    return 0;
+  }
+  if (args[0] == "--version" || args[0] == "-V") {
+    if (args.size() > 1) {
+      std::cerr << "nhdyn: --version takes no arguments\n";
+      return 2;
+    }
+    std::cout << "nhdyn " << nhdyn::version_string << '\n';
     return 0;
   }
   for (const auto& c : cmds) {

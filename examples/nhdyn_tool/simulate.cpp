@@ -23,13 +23,16 @@ namespace nhdyn_tool {
 namespace {
 constexpr std::string_view usage = R"(nhdyn simulate SCENE... --out DIR [--threads N] [--no-plots]
   Runs each SCENE (a JSON file, or the name of a shipped scene: paper-circle,
-  paper-factorial, paper-noise, paper = all three) and writes into DIR (created):
+  paper-factorial, paper-noise, paper = all three; shipped scenes are read from
+  share/nhdyn/scenes beside the tool's bin/ folder, or from $NHDYN_SCENES_DIR) and writes
+  into DIR (created):
     DIR/<run>.csv       t,q1..q5,eta1..eta4,tau1..tau4,r_x,r_y,r_z,rd_x,rd_y,rd_z,err at the
                         scene's output step, from dense output; tau is the torque applied
                         (the held value under zero-order hold), r the plant's true position,
                         err = |r_d - r|; numbers round-trip exact
     DIR/summary.json    [{name, success, max_tail_error, steps, failure, wall_time_s, cpu_time_s, peak_tau}]
-    DIR/<group>-path.png, -error.png, -q.png   figs. 4-6 (gnuplot; one set per scene or study)
+    DIR/<group>-path.png, -error.png, -q.png, -tau.png   figs. 4-6 and tau(t) (gnuplot; one
+                        set per scene or study, each run one colour, named in the legend)
   A study's runs go in parallel on --threads workers (default: all cores), with a progress
   bar when stderr is a terminal. Exit status: 0 all runs succeeded, 1 some run failed,
   2 bad command line.
@@ -40,33 +43,56 @@ struct group {
   std::vector<std::size_t> runs;
 };
 
-/// gnuplot program for one group's figures (figs. 4–6 of the paper).
+/// gnuplot program for one group's figures (figs. 4–6 of the paper, and τ(t)). Every run is
+/// one line style throughout (colour and dash) and named in the legend by what sets it apart
+/// (its name without the group's prefix, e.g. "m3_1.1-d3_0.9-a4_1-a5_1").
 std::string gnuplot_program(const std::filesystem::path& dir, const group& g, const std::vector<std::string>& names) {
   std::ostringstream p;
   const std::string prefix = (dir / g.name).string();
-  p << "set terminal pngcairo size 900,700 noenhanced font ',10'\nset datafile separator ','\n";
+  const auto label = [&](const std::string& run) {
+    const std::string head = g.name + "-";
+    return run.size() > head.size() && run.rfind(head, 0) == 0 ? run.substr(head.size()) : run;
+  };
+  const bool many = g.runs.size() > 1;
+  p << "set terminal pngcairo size " << (many ? 1150 : 900) << ",700 noenhanced font ',10'\nset datafile separator ','\n";
   p << "files = '";
   for (auto i : g.runs) p << (dir / (names[i] + ".csv")).string() << ' ';
-  p << "'\nn = words(files)\nset key " << (g.runs.size() > 1 ? "off" : "top right") << "\nset grid\n";
+  p << "'\ntitles = '";
+  for (auto i : g.runs) p << label(names[i]) << ' ';
+  // Eight colours, then the same eight dashed, dotted…: every run of up to 40 its own line.
+  p << "'\nn = words(files)\nstyle(i) = 1 + int((i - 1) / 8) % 5\nset grid\n";
+  p << (many ? "set key outside right top vertical font ',8' title 'run'\n" : "set key top right\n");
   p << "set output '" << prefix << "-path.png'\nset title '" << g.name
-    << ": path in the ground plane (fig. 4), seen from above'\nset xlabel 'y0 [m]'\nset ylabel 'z0 [m]'\n"
-       "set size ratio -1\n"
+    << ": path in the ground plane (fig. 4), seen from above; dotted: base point (q2, q1)'\n"
+       "set xlabel 'y0 [m]'\nset ylabel 'z0 [m]'\nset size ratio -1\n"
        "plot word(files,1) every ::1 using 19:20 with lines dt 2 lw 2 lc rgb 'black' title 'r_d', \\\n"
-       "  for [f in files] f every ::1 using 16:17 with lines lw 1 title 'r (end effector)', \\\n"
-       "  for [f in files] f every ::1 using 3:2 with lines lw 1 dt 3 title 'base point (q2, q1)'\n"
+       "  for [i=1:n] word(files,i) every ::1 using 16:17 with lines lw 1 lc i dt style(i) title word(titles,i), \\\n"
+       "  for [i=1:n] word(files,i) every ::1 using 3:2 with lines lw 1 dt 3 lc i notitle\n"
        "set size noratio\n";
   p << "set output '" << prefix << "-error.png'\nset title '" << g.name
-    << ": tracking error (fig. 5)'\nset xlabel 't [s]'\nset ylabel '|r_d - r| [m]'\nset logscale y\n"
-       "plot for [f in files] f every ::1 using 1:21 with lines title '|r_d - r|', 0.01 with lines dt 2 lc rgb 'red' title 'criterion (t >= 15 s)'\n"
+    << ": tracking error |r_d - r| (fig. 5)'\nset xlabel 't [s]'\nset ylabel '|r_d - r| [m]'\nset logscale y\n"
+       "plot for [i=1:n] word(files,i) every ::1 using 1:21 with lines lc i dt style(i) title word(titles,i), "
+       "0.01 with lines dt 2 lc rgb 'red' title 'criterion (t >= 15 s)'\n"
        "unset logscale y\n";
-  p << "set output '" << prefix << "-q.png'\nset multiplot layout 5,1 title '" << g.name
-    << ": joint coordinates (fig. 6)'\nset key off\nunset title\nset xlabel ''\n";
-  const char* labels[] = {"q1 [m]", "q2 [m]", "q3 [rad]", "q4 [rad]", "q5 [rad]"};
-  for (int k = 0; k < 5; ++k) {
-    if (k == 4) p << "set xlabel 't [s]'\n";
-    p << "set ylabel '" << labels[k] << "'\nplot for [f in files] f every ::1 using 1:" << k + 2 << " with lines\n";
-  }
-  p << "unset multiplot\n";
+  // Joint coordinates and actuator torques: one panel per column. A legend does not fit
+  // beside a short panel: with several runs, each keeps its line style of the figures above,
+  // whose legends name them.
+  const auto panels = [&](const char* file, const char* what, std::initializer_list<std::pair<int, const char*>> cols) {
+    p << "set output '" << prefix << file << "'\nset multiplot layout " << cols.size() << ",1 title '" << g.name << ": "
+      << what << (many ? " (line styles as in " + g.name + "-error.png)" : std::string())
+      << "'\nunset title\nset xlabel ''\nset key off\n";
+    int k = 0;
+    for (const auto& [col, ylabel] : cols) {
+      if (++k == int(cols.size())) p << "set xlabel 't [s]'\n";
+      p << "set ylabel '" << ylabel << "'\nplot for [i=1:n] word(files,i) every ::1 using 1:" << col
+        << " with lines lc i dt style(i) title word(titles,i)\n";
+    }
+    p << "unset multiplot\nset key\n";
+  };
+  panels("-q.png", "joint coordinates (fig. 6)",
+         {{2, "q1 [m]"}, {3, "q2 [m]"}, {4, "q3 [rad]"}, {5, "q4 [rad]"}, {6, "q5 [rad]"}});
+  panels("-tau.png", "actuator forces and torques applied",
+         {{11, "tau1 (v) [N]"}, {12, "tau2 (omega) [N m]"}, {13, "tau3 (q4) [N m]"}, {14, "tau4 (q5) [N m]"}});
   return p.str();
 }
 
@@ -93,25 +119,24 @@ std::string fixed(double x, int digits) {
 }
 
 int run(const std::vector<std::string>& args) {
-  const auto o = parse_options(args, {"out", "threads"}, {"no-plots"});
-  if (o.help) {
-    std::cout << usage;
-    return 0;
-  }
-  if (o.positional.empty()) throw usage_error("give at least one SCENE");
-  const std::filesystem::path dir = o.required("out");
-  unsigned threads = 0;
-  try {
-    threads = unsigned(std::stoul(o.get("threads", "0")));
-  } catch (const std::exception&) {
-    throw usage_error("--threads needs a non-negative integer");
-  }
+  CLI::App app;
+  std::vector<std::string> scenes;
+  std::string out;
+  int threads = 0;
+  bool no_plots = false;
+  app.add_option("SCENE", scenes)->required();
+  app.add_option("--out", out)->required();
+  add_integer_option(app, "--threads", threads, 0, 4096);
+  app.add_flag("--no-plots", no_plots);
+  if (!parse_command_line(app, args, usage)) return 0;
+  const std::filesystem::path dir = out;
 
   // Expand scenes into runs; a suite's members and every other SCENE are plot groups.
   std::vector<nhdyn::run_spec> specs;
   std::vector<group> groups;
-  const auto add_group = [&](const nhdyn::scene::json& j, const std::string& fallback) {
-    const auto runs = nhdyn::scene::expand(j);
+  const auto add_group = [&](const nhdyn::scene::json& j, const nhdyn::scene::search_path& dirs,
+                             const std::string& fallback) {
+    const auto runs = nhdyn::scene::expand(j, dirs);
     group g{j.is_object() ? j.value("name", fallback) : fallback, {}};
     for (const auto& r : runs) {
       g.runs.push_back(specs.size());
@@ -119,15 +144,20 @@ int run(const std::vector<std::string>& args) {
     }
     groups.push_back(g);
   };
-  for (const auto& s : o.positional) {
-    const auto j = nhdyn::scene::load(s);
+  for (const auto& s : scenes) {
+    const auto [j, dirs] = nhdyn::scene::open(s);  // a file, or a shipped scene's name
     if (j.contains("scenes") && j["scenes"].is_array()) {
-      nhdyn::scene::expand(j);  // validates the suite itself
-      for (const auto& member : j["scenes"])
-        add_group(member.is_string() ? nhdyn::scene::load(member.get<std::string>()) : member,
-                  member.is_string() ? member.get<std::string>() : s);
+      nhdyn::scene::expand(j, dirs);  // validates the suite itself
+      for (const auto& member : j["scenes"]) {
+        if (member.is_string()) {
+          const auto [mj, mdirs] = nhdyn::scene::open(member.get<std::string>(), dirs);
+          add_group(mj, mdirs, member.get<std::string>());
+        } else {
+          add_group(member, dirs, s);
+        }
+      }
     } else {
-      add_group(j, s);
+      add_group(j, dirs, s);
     }
   }
   std::set<std::string> seen;
@@ -145,7 +175,7 @@ int run(const std::vector<std::string>& args) {
   std::mutex m;
   std::size_t done = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  auto results = nhdyn::run_batch(specs, threads, [&](std::size_t i, nhdyn::run_result& r) {
+  auto results = nhdyn::run_batch(specs, unsigned(threads), [&](std::size_t i, nhdyn::run_result& r) {
     const auto tc = std::chrono::steady_clock::now();
     const double cpu0 = nhdyn::detail::thread_cpu_seconds();
     try {
@@ -211,9 +241,9 @@ int run(const std::vector<std::string>& args) {
   double cpu = 0;
   for (const auto& r : results) cpu += r.cpu_time_s;
   std::cout << "total: " << int(results.size()) - failed << "/" << results.size() << " succeeded in "
-            << fixed(total, 2) << " s wall, " << fixed(cpu, 2) << " s cpu (" << (threads ? threads : std::thread::hardware_concurrency())
+            << fixed(total, 2) << " s wall, " << fixed(cpu, 2) << " s cpu (" << (threads ? unsigned(threads) : std::thread::hardware_concurrency())
             << " threads); files in " << dir.string() << '\n';
-  if (!o.values.count("no-plots")) plot(dir, groups, names);
+  if (!no_plots) plot(dir, groups, names);
   return failed ? 1 : 0;
 }
 }  // namespace

@@ -2,75 +2,76 @@
 /// The shared parts of the `nhdyn` tool: options, model loading, the line loop.
 #include "tool.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 
 namespace nhdyn_tool {
 
-const std::string& options::required(const std::string& key) const {
-  const auto it = values.find(key);
-  if (it == values.end()) throw usage_error("missing option --" + key);
-  return it->second;
-}
-
-std::string options::get(const std::string& key, const std::string& fallback) const {
-  const auto it = values.find(key);
-  return it == values.end() ? fallback : it->second;
-}
-
-options parse_options(const std::vector<std::string>& args, const std::vector<std::string>& keys,
-                      const std::vector<std::string>& flags) {
-  const auto among = [](const std::vector<std::string>& v, const std::string& k) {
-    return std::find(v.begin(), v.end(), k) != v.end();
-  };
-  options o;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-h" || a == "--help") {
-      o.help = true;
-    } else if (a.rfind("--", 0) == 0 && a.size() > 2) {
-      std::string key = a.substr(2), value;
-      const auto eq = key.find('=');
-      const bool inline_value = eq != std::string::npos;
-      if (inline_value) {
-        value = key.substr(eq + 1);
-        key = key.substr(0, eq);
-      }
-      if (among(flags, key)) {
-        if (inline_value) throw usage_error("option --" + key + " takes no value");
-        o.values[key] = "1";
-      } else if (among(keys, key)) {
-        if (!inline_value) {
-          if (i + 1 >= args.size()) throw usage_error("option --" + key + " needs a value");
-          value = args[++i];
-        }
-        if (o.values.count(key)) throw usage_error("option --" + key + " given twice");
-        o.values[key] = value;
-      } else {
-        throw usage_error("unknown option --" + key);
-      }
-    } else if (a.size() > 1 && a[0] == '-' && a != "-") {
-      throw usage_error("unknown option " + a);
-    } else {
-      o.positional.push_back(a);
-    }
+bool parse_command_line(CLI::App& app, const std::vector<std::string>& args, std::string_view usage) {
+  app.set_help_flag("-h,--help");
+  app.allow_extras(false);
+  app.positionals_at_end(false);
+  std::vector<const char*> argv{"nhdyn"};
+  for (const auto& a : args) argv.push_back(a.c_str());
+  try {
+    app.parse(static_cast<int>(argv.size()), argv.data());
+  } catch (const CLI::CallForHelp&) {
+    std::cout << usage;
+    return false;
+  } catch (const CLI::ExtrasError&) {
+    std::string msg = "unexpected argument(s):";
+    for (const auto& a : app.remaining()) msg += " " + a;
+    throw usage_error(msg);
+  } catch (const CLI::ParseError& e) {
+    throw usage_error(e.what());
   }
-  return o;
+  return true;
 }
 
-nhdyn::io::model<double> load_model_option(const options& o) {
-  return nhdyn::io::load<double>(o.required("model"));
+CLI::Option* add_integer_option(CLI::App& app, const std::string& name, int& value, int lo, int hi) {
+  return app.add_option(name, value)->transform(CLI::Validator(
+      [lo, hi](std::string& s) -> std::string {  // a transform: it may rewrite s
+        const std::size_t digits = s.size() - (!s.empty() && s[0] == '-');
+        if (digits == 0 || digits > 18 || s.find_first_not_of("0123456789", s[0] == '-' ? 1 : 0) != std::string::npos)
+          return "'" + s + "' is not a decimal integer";
+        const long long v = std::stoll(s);  // decimal (CLI11 alone would read 010 as octal 8)
+        if (v < lo || v > hi)
+          return "'" + s + "' is outside " + std::to_string(lo) + "…" + std::to_string(hi);
+        s = std::to_string(v);
+        return {};
+      },
+      "INTEGER in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]", "integer_in"));
+}
+
+std::filesystem::path data_dir() {
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  // Never the current folder: without /proc/self/exe there is no shipped data to find.
+  return ec ? std::filesystem::path() : exe.parent_path().parent_path() / "share" / "nhdyn";
+}
+
+nhdyn::io::model<double> load_model(const std::string& spec) {
+  // A shipped model by its name (share/nhdyn/models/NAME.json) when it is neither a preset
+  // nor a file.
+  std::error_code ec;
+  const auto dir = data_dir();
+  const auto shipped = dir / "models" / (spec + ".json");
+  const auto names = nhdyn::io::preset_names();
+  const bool preset = std::find(names.begin(), names.end(), spec) != names.end();
+  if (!preset && !std::filesystem::exists(spec, ec) && spec.find('/') == std::string::npos &&
+      !dir.empty() && std::filesystem::is_regular_file(shipped, ec))
+    return nhdyn::io::load<double>(shipped.string());
+  return nhdyn::io::load<double>(spec);
 }
 
 std::optional<nhdyn::io::model<double>> start_model_command(const std::vector<std::string>& args,
                                                             std::string_view usage) {
-  const auto o = parse_options(args, {"model"});
-  if (o.help) {
-    std::cout << usage;
-    return std::nullopt;
-  }
-  if (!o.positional.empty()) throw usage_error("unexpected argument '" + o.positional[0] + "'");
-  return load_model_option(o);
+  CLI::App app;
+  std::string model;
+  app.add_option("--model", model)->required();
+  if (!parse_command_line(app, args, usage)) return std::nullopt;
+  return load_model(model);
 }
 
 // ---------------------------------------------------------------------------------------

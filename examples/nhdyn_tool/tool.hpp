@@ -6,11 +6,13 @@
 /// Adding a subcommand: write examples/nhdyn_tool/<name>.cpp defining
 /// `nhdyn_tool::command nhdyn_tool::command_<name>()`, and add `X(<name>)` to the list in
 /// main.cpp. A line-oriented subcommand starts with `start_model_command` (or, with more
-/// options, `parse_options` and `load_model_option`), and hands a `line_handler` to `run_lines`.
+/// options, its own CLI::App, `parse_command_line` and `load_model`), and hands a
+/// `line_handler` to `run_lines`.
+#include <CLI/CLI.hpp>
 #include <Eigen/Core>
+#include <filesystem>
 #include <functional>
 #include <iosfwd>
-#include <map>
 #include <optional>
 #include <nhdyn/io/json.hpp>
 #include <string>
@@ -35,31 +37,30 @@ struct usage_error : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Parsed command line: `--key value` / `--key=value` options and positional arguments.
-struct options {
-  std::map<std::string, std::string> values;
-  std::vector<std::string> positional;
-  bool help = false;  ///< -h or --help was given
-  /// The value of a required option; throws usage_error if absent.
-  const std::string& required(const std::string& key) const;
-  /// The value of an optional option, or `fallback`.
-  std::string get(const std::string& key, const std::string& fallback) const;
-};
+/// Parses a subcommand's arguments with CLI11, strictly: unknown options, a missing or
+/// repeated value, a number that is not wholly a number, and a value out of range are
+/// usage_errors (exit status 2); `--` ends the options (what follows is positional).
+/// `-h`/`--help` prints `usage` on stdout and returns false (the subcommand then exits 0).
+bool parse_command_line(CLI::App& app, const std::vector<std::string>& args, std::string_view usage);
 
-/// Parses args; `keys` are the options taking a value, `flags` those without
-/// (stored with value "1"). Unknown options are a usage_error.
-options parse_options(const std::vector<std::string>& args, const std::vector<std::string>& keys,
-                      const std::vector<std::string>& flags = {});
+/// An option taking a decimal integer (digits only, an optional leading '-'; 010 is ten)
+/// within [lo, hi]; anything else is a usage_error naming the option.
+CLI::Option* add_integer_option(CLI::App& app, const std::string& name, int& value, int lo, int hi);
 
-/// The model named by --model (a preset name or a file path). Throws nhdyn::error with a
-/// message naming the file, link and field.
-nhdyn::io::model<double> load_model_option(const options& o);
+/// The model named by --model (a preset name, a model file, or a shipped model's name).
+/// Throws nhdyn::error with a message naming the file, link and field.
+nhdyn::io::model<double> load_model(const std::string& spec);
 
 /// The start of every line-oriented subcommand whose only option is --model: parses args,
 /// answers --help by printing `usage` (then returns no model: the subcommand exits 0),
 /// rejects positional arguments (usage_error), and loads the model.
 std::optional<nhdyn::io::model<double>> start_model_command(const std::vector<std::string>& args,
                                                             std::string_view usage);
+
+/// Where the tool's shipped data lives: `share/nhdyn` beside the folder of the running
+/// `nhdyn` (its `bin/`), as `cmake --install` and the build tree (`build/bin/nhdyn`,
+/// `build/share/nhdyn`) lay it out.
+std::filesystem::path data_dir();
 
 // ---------------------------------------------------------------------------------------
 // Lines
@@ -98,8 +99,8 @@ using line_handler = std::function<ordered_json(const line&)>;
 /// always output line k. Returns the exit status: 0 if every line succeeded, 1 otherwise.
 int run_lines(std::istream& in, std::ostream& out, const line_handler& handle);
 
-/// JSON helpers for output: arrays of numbers, row-major matrices (printed with 17
-/// significant digits by run_lines; a NaN or Inf makes the line an error naming the key).
+/// JSON helpers for output: arrays of numbers, row-major matrices (printed in the
+/// shortest form that reads back to the same double by run_lines; a NaN or Inf makes the line an error naming the key).
 ordered_json to_json(const Eigen::VectorXd& v);
 ordered_json to_json(const Eigen::MatrixXd& m);
 

@@ -1,7 +1,7 @@
 #pragma once
 /// \file errors.hpp
 /// nhdyn reports bad input by exceptions, all derived from nhdyn::error (itself a
-/// std::invalid_argument or std::runtime_error): the message names what is wrong and where.
+/// std::runtime_error): the message names what is wrong and where.
 #include <stdexcept>
 #include <string>
 

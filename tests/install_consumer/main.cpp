@@ -2,10 +2,16 @@
 // against closed forms and exits non-zero on a mismatch.
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <nhdyn/nhdyn.hpp>
+#include <nhdyn/version.hpp>
 
 int main() {
   int failures = 0;
+  if (std::strcmp(nhdyn::version_string, NHDYN_EXPECTED_VERSION) != 0) {
+    std::printf("nhdyn/version.hpp says %s, the package %s: MISMATCH\n", nhdyn::version_string, NHDYN_EXPECTED_VERSION);
+    ++failures;
+  }
   const auto check = [&](const char* what, double got, double want, double tol) {
     const bool ok = std::abs(got - want) <= tol * std::max(1.0, std::abs(want));
     std::printf("%-44s got % .15g  want % .15g  %s\n", what, got, want, ok ? "ok" : "MISMATCH");

@@ -12,6 +12,7 @@
 #include <nhdyn/io/json.hpp>
 #include <nhdyn/nhdyn.hpp>
 #include <random>
+#include <nhdyn/version.hpp>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -21,11 +22,7 @@ using Eigen::VectorXd;
 
 namespace {
 
-fs::path source_dir() {
-  const char* s = std::getenv("NHDYN_SOURCE_DIR");
-  REQUIRE(s != nullptr);
-  return s;
-}
+fs::path source_dir() { return NHDYN_SOURCE_DIR; }
 
 fs::path scratch() {
   static const fs::path dir = [] {
@@ -179,7 +176,7 @@ TEST_CASE("tool: id on paper5 gives tau and lambda of the projected equations S^
     input += R"({"q": )" + arr(s.q) + R"(, "eta": )" + arr(s.eta) + R"(, "eta_dot": )" + arr(s.eta_dot) + "}\n";
   // The same through a model file: identical output, byte for byte.
   const auto r = run_tool("id --model paper5", input);
-  const auto from_file = run_tool("id --model '" + (source_dir() / "examples/paper5.json").string() + "'", input);
+  const auto from_file = run_tool("id --model '" + (source_dir() / "examples/models/paper5.json").string() + "'", input);
   REQUIRE(r.status == 0);
   REQUIRE(r.lines.size() == states.size());
   REQUIRE(from_file.out == r.out);
@@ -291,7 +288,7 @@ TEST_CASE("tool: the line form must match the model (constraint or not), in id a
 
 TEST_CASE("tool: an invalid or unreadable model is an error on stderr before any line is read") {
   const std::string line = R"({"q": [0], "qd": [0], "qdd": [0]})" "\n";
-  auto bad = json::parse(read_text(source_dir() / "examples/paper5.json"));
+  auto bad = json::parse(read_text(source_dir() / "examples/models/paper5.json"));
   bad["links"][3]["mass"] = -1;
   const auto bad_path = scratch() / "negative_mass.json";
   std::ofstream(bad_path) << bad.dump(2);
@@ -348,10 +345,19 @@ TEST_CASE("tool: --help documents every subcommand; a bad command line is exit s
   const std::vector<std::pair<std::string, std::string>> usage_errors = {
       {"", "Usage"},
       {"frobnicate", "unknown command 'frobnicate'"},
-      {"id", "missing option --model"},
-      {"id --model", "--model needs a value"},
-      {"id --model paper5 --speed 3", "unknown option --speed"},
-      {"fd --model paper5 extra", "unexpected argument 'extra'"},
+      {"id", "--model is required"},
+      {"id --model", "--model: 1 required"},
+      {"id --model paper5 --speed 3", "unexpected argument(s): --speed"},
+      {"id --model paper5 --model puma560", "--model: At Most 1"},
+      {"fd --model paper5 extra", "unexpected argument(s): extra"},
+      {"id -- --model paper5", "--model is required"},  // after --, nothing is an option
+      {"--version extra", "--version takes no arguments"},
+      {"simulate paper --out x --threads -1", "--threads: '-1' is outside 0…4096"},
+      {"simulate paper --out x --threads 4x", "--threads: '4x' is not a decimal integer"},
+      {"simulate paper --out x --threads 0x10", "--threads: '0x10' is not a decimal integer"},
+      {"simulate paper --out x --threads ' 4'", "--threads: ' 4' is not a decimal integer"},
+      {"simulate paper --out x --threads 99999999999999999999", "is not a decimal integer"},
+      {"simulate paper --out x --no-plots=maybe", "--no-plots"},
   };
   for (const auto& [args, msg] : usage_errors) {
     INFO(args);
@@ -360,6 +366,14 @@ TEST_CASE("tool: --help documents every subcommand; a bad command line is exit s
     CHECK(r.out.empty());
     CHECK(r.err.find(msg) != std::string::npos);
   }
+  // Numbers are decimal: 010 is ten threads (CLI11 alone reads it as octal 8).
+  const auto ten = run_tool("simulate paper-circle --no-plots --threads 010 --out '" + (scratch() / "ten").string() + "'", "");
+  CHECK(ten.status == 0);
+  CHECK(ten.out.find("(10 threads)") != std::string::npos);
+  // --version prints the version of nhdyn/version.hpp.
+  const auto v = run_tool("--version", "");
+  CHECK(v.status == 0);
+  CHECK(v.out == std::string("nhdyn ") + nhdyn::version_string + "\n");
   // --model=MODEL works too; no input lines, no output, success.
   const auto eq = run_tool("id --model=puma560", "");
   CHECK(eq.status == 0);

@@ -32,6 +32,8 @@ class nh_forward_dynamics_fn : public stage_tag {
   template <class Q>
   auto reduced_inertia(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<S, typename Q::Scalar>;
+    detail::check_size(q, c_.dof(), "q");
+    detail::check_finite(q, "q");
     const int m = c_.m();
     matrix<T, M, M> Me(m, m);
     if (method_ == reduced_inertia_method::crba) {
@@ -53,14 +55,16 @@ class nh_forward_dynamics_fn : public stage_tag {
   /// wants to know before (or to switch to a damped model) asks here.
   template <class Q>
   double reduced_inertia_condition(const Eigen::MatrixBase<Q>& q) const {
-    detail::check_size(q, c_.dof(), "q");
-    detail::check_finite(q, "q");
-    return condition_number(reduced_inertia(q));
+    return condition_number(reduced_inertia(q));  // which checks q
   }
 
   /// h_η = Sᵀ rne(q, Sη, Ṡη).
   template <class Q, class E>
   auto reduced_bias(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta) const {
+    detail::check_size(q, c_.dof(), "q");
+    detail::check_size(eta, c_.m(), "eta");
+    detail::check_finite(q, "q");
+    detail::check_finite(eta, "eta");
     const auto qd = apply_S(c_, q, eta);
     return apply_St(c_, q, rne_(q, qd, apply_Sdot(c_, q, qd, eta)));
   }

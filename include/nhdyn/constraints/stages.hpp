@@ -35,6 +35,16 @@ template <class C>
 struct constraint_scalar<C> {
   using type = typename C::scalar_type;
 };
+/// The projection's input checks (q and v: n entries each, finite), for a call on (q, v)
+/// given by a caller. Inside project ∘ rne ∘ lift they were checked upstream: the stage on a
+/// temporary (q, v) checks v's size only.
+template <class C, class Q, class V>
+void check_projection_input(const C& c, const Q& q, const V& v) {
+  check_size(q, c.dof(), "q");
+  check_size(v, c.dof(), "v");
+  check_finite(q, "q");
+  check_finite(v, "v");
+}
 /// The lift's input checks: sizes n, m, m, then every entry finite.
 template <class C, class Q, class E, class ED>
 void check_reduced_state(const C& c, const Q& q, const E& eta, const ED& eta_dot) {
@@ -140,7 +150,7 @@ class project_fn : public stage_tag {
   /// τ = (SᵀE)⁻¹ Sᵀ v (m entries).
   template <class Q, class V>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
-    detail::check_size(v, c_.dof(), "v");
+    detail::check_projection_input(c_, q, v);
     return detail::solve_StE(c_, q, apply_St(c_, q, v));
   }
   template <class X, int N>
@@ -189,7 +199,7 @@ class constraint_forces_fn : public stage_tag {
 
   template <class Q, class V>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
-    const auto tau = p_(q, v);
+    const auto tau = p_(q, v);  // checks q and v
     using T = typename decltype(tau)::Scalar;
     constexpr int M = C::m_at_compile_time, K = C::k_at_compile_time;
     constrained_forces<T, M, K> out;

@@ -9,6 +9,7 @@
 /// Every nhdyn algorithm object is a stage; `stage(callable)` makes any callable one, so
 /// users can insert their own (a friction model, a wheel-speed map, a logger).
 #include <concepts>
+#include <functional>
 #include <tuple>
 #include <type_traits>
 #include <utility>

@@ -15,8 +15,8 @@
 /// Standard DH (Spong), com in link frame i, inertia about the centre of mass in frame i's
 /// axes, radians and SI units. Every field of a link is required; unknown fields, duplicate
 /// keys, wrong types or lengths and numbers that overflow are errors naming the file, the link
-/// (1-based) and the field. Numbers are read as double and saved with 17 significant digits,
-/// so save → load is exact. Needs nlohmann/json (Debian nlohmann-json3-dev).
+/// (1-based) and the field. Numbers are read as double and saved in their shortest
+/// round-trip form (io/number.hpp), so save → load is exact. Needs nlohmann/json (Debian nlohmann-json3-dev).
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -35,6 +35,7 @@
 #include "../errors.hpp"
 #include "../model/chain.hpp"
 #include "../model/presets.hpp"
+#include "number.hpp"
 
 namespace nhdyn::io {
 
@@ -52,18 +53,6 @@ struct model {
 // ---------------------------------------------------------------------------------------
 // Numbers and JSON text
 // ---------------------------------------------------------------------------------------
-
-/// x with 17 significant digits (%.17g): reading it back gives x bit for bit (−0 is
-/// written "-0.0" so that a JSON reader keeps its sign).
-/// Throws numerical_error for NaN or Inf, which JSON cannot represent.
-inline std::string format_number(double x) {
-  if (!std::isfinite(x)) throw numerical_error(std::isnan(x) ? "result is NaN" : "result is infinite");
-  if (x == 0 && std::signbit(x)) return "-0.0";  // "-0" would read back as the integer 0
-  if (x == 0 && std::signbit(x)) return "-0.0";  // "-0" would read back as the integer 0
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
 
 namespace detail {
 inline void dump_string(const std::string& s, std::string& out) {
@@ -126,8 +115,8 @@ void dump(const J& j, std::string& out, int indent, int level) {
 }
 }  // namespace detail
 
-/// JSON text with every floating-point number printed by format_number (17 significant
-/// digits). indent < 0: one line ("{"a": [1, 2]}"); otherwise nested, arrays of scalars on
+/// JSON text with every floating-point number printed by format_number (the shortest form
+/// that reads back to the same double). indent < 0: one line ("{"a": [1, 2]}"); otherwise nested, arrays of scalars on
 /// one line. Throws numerical_error if a number is NaN or Inf.
 template <class J>
 std::string dump(const J& j, int indent = -1) {
@@ -443,7 +432,7 @@ ordered_json to_json(const model<S>& m) {
   return to_json(m.chain, m.constraint ? &*m.constraint : nullptr, m.description);
 }
 
-/// The model file's text (indented, numbers with 17 significant digits).
+/// The model file's text (indented, numbers in their shortest round-trip form).
 template <class S>
 std::string to_string(const model<S>& m) {
   return dump(to_json(m), 2) + "\n";

@@ -80,6 +80,7 @@ class kinematics {
   template <class Q>
   auto point(const Eigen::MatrixBase<Q>& q, int i, const vec3<S>& p_i = vec3<S>::Zero()) const {
     using T = promote_t<S, typename Q::Scalar>;
+    check_point(p_i);
     const auto X = frame(q, i);
     return vec3<T>(X.p + X.R * p_i.template cast<T>());
   }
@@ -89,6 +90,7 @@ class kinematics {
   auto jacobian(const Eigen::MatrixBase<Q>& q, int i, const vec3<S>& p_i = vec3<S>::Zero()) const {
     using T = promote_t<S, typename Q::Scalar>;
     check_link(i, true);
+    check_point(p_i);
     const auto X = forward(q);
     const vec3<T> p = X[std::size_t(i)].p + X[std::size_t(i)].R * p_i.template cast<T>();
     Eigen::Matrix<T, 6, N> J = Eigen::Matrix<T, 6, N>::Zero(6, n_);
@@ -111,8 +113,11 @@ class kinematics {
                  const vec3<S>& p_i = vec3<S>::Zero()) const {
     using T = promote_t<S, typename Q::Scalar>;
     check_link(i, true);
+    detail::check_size(q, n_, "q");
     detail::check_size(qd, n_, "qd");
+    detail::check_finite(q, "q");
     detail::check_finite(qd, "qd");
+    check_point(p_i);
     vec3<T> w = vec3<T>::Zero(), dw = vec3<T>::Zero(), acc = vec3<T>::Zero();  // frame j
     mat3<T> R = mat3<T>::Identity();                                          // R_0j
     for (int j = 0; j < i; ++j) {
@@ -140,6 +145,10 @@ class kinematics {
   }
 
  private:
+  static void check_point(const vec3<S>& p_i) {
+    for (int r = 0; r < 3; ++r)
+      if (!is_finite_scalar(p_i(r))) detail::throw_not_finite("p_i", r, value_of(p_i(r)));
+  }
   void check_link(int i, bool allow_base) const {
     if (i < (allow_base ? 0 : 1) || i > n_)
       throw input_error("link index " + std::to_string(i) + " is outside 0…" + std::to_string(n_));

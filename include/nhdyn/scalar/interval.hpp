@@ -388,7 +388,7 @@ inline bool interval::monotonic_piece(const interval& a, double shift, double vl
 
 namespace nhdyn {
 /// Prints [lo, hi] (17 significant digits; for bounds that must not narrow when printed,
-/// see analysis/bounds.hpp, print_outward).
+/// see analysis/bounds.hpp, format_lower and format_upper).
 inline std::ostream& operator<<(std::ostream& os, const nhdyn::interval& x) {
   const auto p = os.precision(17);
   os << "[" << x.lower() << ", " << x.upper() << "]";

@@ -14,7 +14,8 @@
 ///               → the full factorial over the factors' levels (path: a JSON pointer)
 ///     suite  = {"name", "description", "scenes": [scene | study | suite | "name", …]}
 ///
-///     auto runs = nhdyn::scene::expand(nhdyn::scene::load("paper-factorial"));  // 16 run_specs
+///     auto f = nhdyn::scene::open("paper-factorial");   // a shipped scene, or a file path
+///     auto runs = nhdyn::scene::expand(f.j, f.dirs);       // its 16 run_specs
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -196,62 +197,108 @@ inline run_spec parse_run(const json& j) {
   return s;
 }
 
-/// Where shipped scenes are looked for: $NHDYN_SCENES_DIR, then examples/scenes under the
-/// current directory and its parents, then under the executable's directory and parents.
-inline std::vector<std::filesystem::path> scene_dirs() {
+/// Where scenes named by name (not by path) are looked for, in order.
+using search_path = std::vector<std::filesystem::path>;
+
+/// The shipped scenes' folder: $NHDYN_SCENES_DIR if set, else `share/nhdyn/scenes` beside the
+/// running program's `bin/` (the layout of both `cmake --install` and nhdyn's build tree,
+/// whose tool is `build/bin/nhdyn`). Never the current directory: a program finds its data
+/// wherever it is run from.
+inline search_path default_search_path() {
   namespace fs = std::filesystem;
-  std::vector<fs::path> dirs;
-  if (const char* e = std::getenv("NHDYN_SCENES_DIR")) dirs.emplace_back(e);
-#ifdef NHDYN_SCENES_INSTALL_DIR
-  dirs.emplace_back(NHDYN_SCENES_INSTALL_DIR);
-#endif
+  search_path dirs;
+  if (const char* e = std::getenv("NHDYN_SCENES_DIR"); e && *e) dirs.emplace_back(e);
   std::error_code ec;
-  std::vector<fs::path> starts{fs::current_path(ec)};
-  if (const auto exe = fs::read_symlink("/proc/self/exe", ec); !ec) starts.push_back(exe.parent_path());
-  for (auto p : starts)
-    for (; !p.empty(); p = p.parent_path()) {
-      dirs.push_back(p / "examples" / "scenes");
-      if (p == p.parent_path()) break;
-    }
+  if (const auto exe = fs::read_symlink("/proc/self/exe", ec); !ec)
+    dirs.push_back(exe.parent_path().parent_path() / "share" / "nhdyn" / "scenes");
   return dirs;
 }
 
-/// A scene, study or suite from a file path or a shipped scene's name.
-inline json load(const std::string& name_or_path) {
+/// A scene file's JSON, and where the scene names it uses are looked up: its own folder
+/// first, then the search path it was found with.
+struct opened {
+  json j;
+  search_path dirs;
+};
+
+namespace detail {
+/// dirs with `first` in front.
+inline search_path with_first(const std::filesystem::path& first, const search_path& dirs) {
+  search_path out{first.empty() ? std::filesystem::path(".") : first};
+  out.insert(out.end(), dirs.begin(), dirs.end());
+  return out;
+}
+}  // namespace detail
+
+/// A scene, study or suite from a file path, or a scene's name looked up in `dirs`.
+inline opened open(const std::string& name_or_path, const search_path& dirs = default_search_path()) {
   namespace fs = std::filesystem;
   fs::path file;
   std::error_code ec;
   if (fs::is_regular_file(name_or_path, ec)) {
     file = name_or_path;
   } else {
-    for (const auto& d : scene_dirs())
+    for (const auto& d : dirs)
       if (fs::is_regular_file(d / (name_or_path + ".json"), ec)) {
         file = d / (name_or_path + ".json");
         break;
       }
   }
-  if (file.empty())
-    throw input_error("scene '" + name_or_path +
-                      "': no such file, and no shipped scene of that name (looked in examples/scenes; set NHDYN_SCENES_DIR)");
+  if (file.empty()) {
+    std::string looked;
+    for (const auto& d : dirs) looked += (looked.empty() ? "" : ", ") + d.string();
+    throw input_error("scene '" + name_or_path + "': no such file, and no scene of that name in " +
+                      (looked.empty() ? std::string("(no folder)") : looked) +
+                      " (shipped scenes: set NHDYN_SCENES_DIR to their folder)");
+  }
   std::ifstream f(file);
   std::stringstream text;
   text << f.rdbuf();
-  return io::parse_strict<input_error>(text.str(), "scene file '" + file.string() + "': ");
+  if (!f) throw input_error("scene file '" + file.string() + "': cannot be read");
+  return {io::parse_strict<input_error>(text.str(), "scene file '" + file.string() + "': "),
+          detail::with_first(file.parent_path(), dirs)};
+}
+
+/// open(…)'s JSON alone.
+inline json load(const std::string& name_or_path, const search_path& dirs = default_search_path()) {
+  return open(name_or_path, dirs).j;
 }
 
 namespace detail {
 inline std::string level_text(const json& v) {
   if (v.is_number_float()) {
     std::string s;
-    append_number(s, v.get<double>());
+    io::append_number(s, v.get<double>());
     return s;
   }
   return v.is_string() ? v.get<std::string>() : v.dump();
 }
 
-inline void expand_into(const json& j, std::vector<run_spec>& out, int depth) {
+/// A scene named inside a scene file: a path relative to that file's folder (dirs' first),
+/// or a name looked up in dirs; never the current folder.
+inline opened open_nested(const std::string& ref, const search_path& dirs) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::path(ref).is_absolute() || dirs.empty()) return open(ref, dirs);
+  if (fs::is_regular_file(dirs.front() / ref, ec)) return open((dirs.front() / ref).string(), dirs);
+  for (const auto& d : dirs)
+    if (fs::is_regular_file(d / (ref + ".json"), ec)) return open((d / (ref + ".json")).string(), dirs);
+  std::string looked;
+  for (const auto& d : dirs) looked += (looked.empty() ? "" : ", ") + d.string();
+  throw input_error("scene '" + ref + "': no such file in " + dirs.front().string() + ", and no scene of that name in " +
+                    looked);
+}
+
+inline void expand_into(const json& j, std::vector<run_spec>& out, int depth, const search_path& outer) {
   if (depth > 16) throw input_error("scenes nest more than 16 deep (a suite that includes itself?)");
-  const json resolved = j.is_string() ? load(j.get<std::string>()) : j;
+  // A name is looked up in the folder of the file that names it first, then in `outer`.
+  search_path dirs = outer;
+  json resolved = j;
+  if (j.is_string()) {
+    auto l = depth == 0 ? open(j.get<std::string>(), outer) : open_nested(j.get<std::string>(), outer);
+    resolved = std::move(l.j);
+    dirs = std::move(l.dirs);
+  }
   if (!resolved.is_object()) throw input_error("a scene must be a JSON object or a scene name");
   const std::string name = resolved.contains("name") && resolved["name"].is_string() ? resolved["name"].get<std::string>()
                                                                                        : std::string("(unnamed)");
@@ -259,12 +306,12 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth) {
   if (resolved.contains("scenes")) {
     const object o(resolved, where, "", {"name", "description", "scenes"});
     if (!resolved["scenes"].is_array()) throw input_error(where + "field 'scenes' must be a list");
-    for (const auto& s : resolved["scenes"]) expand_into(s, out, depth + 1);
+    for (const auto& s : resolved["scenes"]) expand_into(s, out, depth + 1, dirs);
   } else if (resolved.contains("study")) {
     const object o(resolved, where, "", {"name", "description", "study"});
     const object st = o.sub("study", {"base", "set", "factors"});
     if (!st.has("base")) throw input_error(where + "field 'study.base' is required");
-    json base = st.j["base"].is_string() ? load(st.j["base"].get<std::string>()) : st.j["base"];
+    json base = st.j["base"].is_string() ? load(st.j["base"].get<std::string>(), dirs) : st.j["base"];
     if (!base.is_object() || base.contains("study") || base.contains("scenes"))
       throw input_error(where + "field 'study.base' must be a single scene");
     if (st.has("set")) {
@@ -330,11 +377,12 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth) {
 }
 }  // namespace detail
 
-/// The runs of a scene (one), a study (its design) or a suite (all of its members').
-inline std::vector<run_spec> expand(const json& j) {
+/// The runs of a scene (one), a study (its design) or a suite (all of its members'). Scenes
+/// it names are looked up in `dirs`.
+inline std::vector<run_spec> expand(const json& j, const search_path& dirs = default_search_path()) {
   std::vector<run_spec> out;
   try {
-    detail::expand_into(j, out, 0);
+    detail::expand_into(j, out, 0, dirs);
   } catch (const json::exception& e) {  // a shape the checks above missed: still an input error
     throw input_error(std::string("scene: ") + e.what());
   }

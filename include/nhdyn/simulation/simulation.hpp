@@ -25,6 +25,7 @@
 #include <sstream>
 
 #include "../constraints/forward_dynamics.hpp"
+#include "../io/number.hpp"
 #include "../model/presets.hpp"
 #include "controller.hpp"
 #include "integrators.hpp"
@@ -226,11 +227,6 @@ inline run_result simulate(const run_spec& s) {
 }
 
 /// Shortest round-trip decimal form of x (std::to_chars): parsing it gives x back exactly.
-inline void append_number(std::string& out, double x) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, x);
-  out.append(buf, r.ptr);
-}
 
 /// Writes a run's rows as CSV with a header naming each column (run_columns()).
 inline void write_csv(const std::string& path, const run_result& res) {
@@ -241,7 +237,7 @@ inline void write_csv(const std::string& path, const run_result& res) {
   for (Eigen::Index i = 0; i < res.rows.rows(); ++i) {
     for (Eigen::Index j = 0; j < res.rows.cols(); ++j) {
       if (j) text += ',';
-      append_number(text, res.rows(i, j));
+      io::append_number(text, res.rows(i, j));
     }
     text += '\n';
   }
