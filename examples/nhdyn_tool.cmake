@@ -13,6 +13,10 @@ add_library(nhdyn_tool_objects OBJECT ${NHDYN_TOOL_SOURCES})
 target_link_libraries(nhdyn_tool_objects PUBLIC nhdyn::json nhdyn::boost CLI11::CLI11
                                          PRIVATE nhdyn_project_options)
 target_include_directories(nhdyn_tool_objects PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/nhdyn_tool)
+if(TARGET nhdyn::urdf)  # --model x.urdf
+  target_link_libraries(nhdyn_tool_objects PUBLIC nhdyn::urdf)
+  target_compile_definitions(nhdyn_tool_objects PRIVATE NHDYN_TOOL_URDF=1)
+endif()
 add_executable(nhdyn_tool ${CMAKE_CURRENT_SOURCE_DIR}/nhdyn_tool/main.cpp)
 set_target_properties(nhdyn_tool PROPERTIES OUTPUT_NAME nhdyn RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/${CMAKE_INSTALL_BINDIR})
 target_link_libraries(nhdyn_tool PRIVATE nhdyn_tool_objects nhdyn_project_options)

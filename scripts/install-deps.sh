@@ -6,6 +6,7 @@ pkgs=(
   build-essential cmake g++ clang-14 libclang-rt-14-dev
   libeigen3-dev librange-v3-dev catch2 libbenchmark-dev
   libboost-dev liborocos-kdl-dev nlohmann-json3-dev libcli11-dev
+  liburdfdom-dev libtinyxml2-dev
   gnuplot-nox python3 python3-matplotlib
 )
 missing=()

@@ -2,6 +2,7 @@
 /// `nhdyn fd`: forward dynamics on JSON lines. Holonomic models: q̈ = M⁻¹(τ − bias)
 /// (forward_dynamics). Models with a constraint: η̇ = M_η⁻¹(SᵀEτ − h_η) (nh_forward_dynamics).
 #include <iostream>
+#include <nhdyn/dynamics/tree.hpp>
 #include <nhdyn/nhdyn.hpp>
 
 #include "tool.hpp"
@@ -9,19 +10,31 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn fd --model MODEL
+constexpr std::string_view usage = R"(nhdyn fd --model MODEL [--strict]
   Forward dynamics. Reads JSON lines on stdin, writes one JSON line per input line.
   Model without a constraint (n joints):
     {"q": [n], "qd": [n], "tau": [n]}        ->  {"qdd": [n]}         qdd = M(q)^-1 (tau - bias(q, qd))
   Model with a constraint (m actuator velocities):
     {"q": [n], "eta": [m], "tau": [m]}       ->  {"eta_dot": [m]}     eta_dot = M_eta^-1 (S^T E tau - h_eta)
+  A URDF model is a tree without a constraint (the first form; q in `nhdyn model` order).
   A singular or near-singular (reduced) mass matrix is an error line.
+  --strict: a URDF inertia that is not physically valid is an error instead of a warning.
 )";
 
 int run(const std::vector<std::string>& args) {
-  const auto model = start_model_command(args, usage);
-  if (!model) return 0;  // --help
-  const auto& m = *model;
+  const auto any = start_any_model_command(args, usage);
+  if (!any) return 0;  // --help
+  if (any->tree) {
+    const auto& t = *any->tree;
+    const auto fd = nhdyn::forward_dynamics(t);
+    const int n = t.dof();
+    return run_lines(std::cin, std::cout, [&](const line& l) {
+      l.expect_keys({"q", "qd", "tau"});
+      const Eigen::VectorXd qdd = fd(l.vector("q", n), l.vector("qd", n), l.vector("tau", n));
+      return ordered_json{{"qdd", to_json(qdd)}};
+    });
+  }
+  const auto& m = *any->dh;
   const auto& ch = m.chain;
   const int n = ch.dof();
   if (!m.constraint) {

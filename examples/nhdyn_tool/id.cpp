@@ -3,6 +3,7 @@
 /// Models with a constraint: (τ, λ) = inverse_dynamics_with_forces(q, η, η̇), i.e. the
 /// projection of rne ∘ lift (paper eqs. 18–19) and λ = (AAᵀ)⁻¹A(v − Eτ).
 #include <iostream>
+#include <nhdyn/dynamics/tree.hpp>
 #include <nhdyn/nhdyn.hpp>
 
 #include "tool.hpp"
@@ -10,13 +11,15 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn id --model MODEL
+constexpr std::string_view usage = R"(nhdyn id --model MODEL [--strict]
   Inverse dynamics. Reads JSON lines on stdin, writes one JSON line per input line.
   Model without a constraint (n joints):
     {"q": [n], "qd": [n], "qdd": [n]}        ->  {"tau": [n]}         tau = rne(q, qd, qdd)
   Model with a constraint (m = n - k actuator velocities; paper5: eta = (v, omega, qd4, qd5)):
     {"q": [n], "eta": [m], "eta_dot": [m]}   ->  {"tau": [m], "lambda": [k]}
+  A URDF model is a tree without a constraint (the first form; q in `nhdyn model` order).
   Keys must be exactly those of the model's form; anything else is an error line.
+  --strict: a URDF inertia that is not physically valid is an error instead of a warning.
 )";
 
 ordered_json holonomic(const nhdyn::chain<double>& ch, const line& l) {
@@ -27,9 +30,19 @@ ordered_json holonomic(const nhdyn::chain<double>& ch, const line& l) {
 }
 
 int run(const std::vector<std::string>& args) {
-  const auto model = start_model_command(args, usage);
-  if (!model) return 0;  // --help
-  const auto& m = *model;
+  const auto any = start_any_model_command(args, usage);
+  if (!any) return 0;  // --help
+  if (any->tree) {
+    const auto& t = *any->tree;
+    const auto id = nhdyn::rne(t);
+    const int n = t.dof();
+    return run_lines(std::cin, std::cout, [&](const line& l) {
+      l.expect_keys({"q", "qd", "qdd"});
+      const Eigen::VectorXd tau = id(l.vector("q", n), l.vector("qd", n), l.vector("qdd", n));
+      return ordered_json{{"tau", to_json(tau)}};
+    });
+  }
+  const auto& m = *any->dh;
   const auto& ch = m.chain;
   const int n = ch.dof();
   if (!m.constraint)

@@ -7,6 +7,7 @@
 /// `nhdyn_tool::command nhdyn_tool::command_<name>()`. Adding a subcommand is one file
 /// plus one line here.
 #define NHDYN_TOOL_COMMANDS(X) \
+  X(model)                     \
   X(id)                        \
   X(fd)                        \
   X(linearize)                 \
@@ -47,7 +48,8 @@ void print_help(std::ostream& os, const std::vector<command>& cmds) {
   os << "\nMODEL is a preset name (";
   const auto names = nhdyn::io::preset_names();
   for (std::size_t i = 0; i < names.size(); ++i) os << (i ? ", " : "") << names[i];
-  os << "), the path of a JSON model file (docs/model-format.md), or the name of a model\n"
+  os << "), the path of a JSON model file (docs/model-format.md), the path of a URDF\n"
+        "file (*.urdf; model, id and fd; docs/trees-and-urdf.md), or the name of a model\n"
         "shipped in share/nhdyn/models.\n"
         "Line-oriented commands read one JSON object per line on stdin and write one JSON line\n"
         "per input line on stdout, in order; a bad line gets {\"error\": \"line N: ...\"} and the\n"

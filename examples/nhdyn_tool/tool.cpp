@@ -3,6 +3,10 @@
 #include "tool.hpp"
 
 #include <algorithm>
+#include <cctype>
+#ifdef NHDYN_TOOL_URDF
+#include <nhdyn/io/urdf.hpp>
+#endif
 #include <cmath>
 #include <iostream>
 
@@ -51,7 +55,38 @@ std::filesystem::path data_dir() {
   return ec ? std::filesystem::path() : exe.parent_path().parent_path() / "share" / "nhdyn";
 }
 
+bool is_urdf(const std::string& spec) {
+  std::string ext = std::filesystem::path(spec).extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".urdf";
+}
+
+any_model load_any_model(const std::string& spec, bool strict) {
+  if (!is_urdf(spec)) return {load_model(spec), std::nullopt};
+#ifdef NHDYN_TOOL_URDF
+  nhdyn::io::urdf_options o;
+  o.strict = strict;
+  return {std::nullopt, nhdyn::io::load_urdf(spec, o)};
+#else
+  (void)strict;
+  throw nhdyn::model_error(spec + ": this nhdyn was built without URDF support (urdfdom, tinyxml2)");
+#endif
+}
+
+std::optional<any_model> start_any_model_command(const std::vector<std::string>& args, std::string_view usage) {
+  CLI::App app;
+  std::string model;
+  bool strict = false;
+  app.add_option("--model", model)->required();
+  app.add_flag("--strict", strict);
+  if (!parse_command_line(app, args, usage)) return std::nullopt;
+  return load_any_model(model, strict);
+}
+
 nhdyn::io::model<double> load_model(const std::string& spec) {
+  if (is_urdf(spec))
+    throw nhdyn::model_error(spec + ": URDF models work with `nhdyn model`, `id` and `fd` so far; this command "
+                                    "takes a preset or a JSON model");
   // A shipped model by its name (share/nhdyn/models/NAME.json) when it is neither a preset
   // nor a file.
   std::error_code ec;

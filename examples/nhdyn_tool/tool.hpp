@@ -15,6 +15,7 @@
 #include <iosfwd>
 #include <optional>
 #include <nhdyn/io/json.hpp>
+#include <nhdyn/model/tree.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -56,6 +57,21 @@ nhdyn::io::model<double> load_model(const std::string& spec);
 /// rejects positional arguments (usage_error), and loads the model.
 std::optional<nhdyn::io::model<double>> start_model_command(const std::vector<std::string>& args,
                                                             std::string_view usage);
+
+/// A model as the tool loads it: a DH model (preset, JSON file; with its constraint if any)
+/// or a kinematic tree from a URDF file. Exactly one is set.
+struct any_model {
+  std::optional<nhdyn::io::model<double>> dh;
+  std::optional<nhdyn::tree<double>> tree;
+  const std::string& name() const { return dh ? dh->chain.name() : tree->name(); }
+};
+/// Whether MODEL names a URDF file (its extension is .urdf, any case).
+bool is_urdf(const std::string& spec);
+/// load_model, and URDF files (*.urdf); `strict`: a non-physical inertia in a URDF is an error
+/// instead of a warning on stderr.
+any_model load_any_model(const std::string& spec, bool strict = false);
+/// start_model_command for the subcommands that take any model: `--model MODEL [--strict]`.
+std::optional<any_model> start_any_model_command(const std::vector<std::string>& args, std::string_view usage);
 
 /// Where the tool's shipped data lives: `share/nhdyn` beside the folder of the running
 /// `nhdyn` (its `bin/`), as `cmake --install` and the build tree (`build/bin/nhdyn`,

@@ -105,6 +105,9 @@ struct validation {
   /// Principal moments must satisfy I₁ + I₂ ≥ I₃ (every rigid body does). Some published
   /// models do not (Corke's Puma 560, links 1 and 3); turning this off loads them as published.
   bool triangle_inequality = true;
+  /// The inertia about the centre of mass must be positive semi-definite. Trees only (a chain
+  /// always checks it): a URDF loaded leniently turns it off after warning (io/urdf.hpp).
+  bool positive_semidefinite = true;
 };
 
 /// A serial chain of N joints (N = nhdyn::dynamic for a run-time size), in the number type S

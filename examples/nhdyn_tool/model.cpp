@@ -1,0 +1,67 @@
+/// \file model.cpp
+/// `nhdyn model`: one JSON object describing a model, so that a program can line its vectors
+/// up with it: name, dof, joint names in q order, the names of η's entries, k, gravity.
+#include <iostream>
+#include <nhdyn/nhdyn.hpp>
+
+#include "tool.hpp"
+
+namespace nhdyn_tool {
+
+namespace {
+constexpr std::string_view usage = R"(nhdyn model --model MODEL [--strict]
+  Prints one JSON object describing MODEL:
+    {"name": ..., "dof": n, "joints": [n names, q order], "eta": [m names], "k": k,
+     "gravity": [gx, gy, gz]}
+  eta names the entries of eta (the actuator velocities of a model with a constraint:
+  "v" forward speed, "omega" yaw rate (the heading joint's rate), the other joints); without a constraint eta is
+  the joint names and k is 0. DH models name their joints joint1...jointn; a URDF's joints
+  keep their names, movable joints only, in the documented order (docs/trees-and-urdf.md).
+  --strict: a URDF inertia that is not physically valid is an error instead of a warning.
+)";
+
+ordered_json describe(const std::string& name, const std::vector<std::string>& joints,
+                      const std::vector<std::string>& eta, int k, const Eigen::Vector3d& g) {
+  ordered_json j;
+  j["name"] = name;
+  j["dof"] = joints.size();
+  j["joints"] = joints;
+  j["eta"] = eta;
+  j["k"] = k;
+  j["gravity"] = to_json(Eigen::VectorXd(g));
+  return j;
+}
+
+int run(const std::vector<std::string>& args) {
+  const auto model = start_any_model_command(args, usage);
+  if (!model) return 0;  // --help
+  ordered_json out;
+  if (model->tree) {
+    const auto& t = *model->tree;
+    out = describe(t.name(), t.joint_names(), t.joint_names(), 0, t.gravity());
+  } else {
+    const auto& m = *model->dh;
+    const auto joints = nhdyn::as_tree(m.chain).joint_names();
+    std::vector<std::string> eta = joints;
+    int k = 0;
+    if (m.constraint) {
+      const auto& c = *m.constraint;
+      eta.clear();
+      for (int j = 0; j < c.n; ++j) {
+        if (j == std::max(c.x, c.y)) continue;
+        // η's entry of the heading joint is its rate q̇_h: the yaw rate ω when heading_sign is +1
+        const bool omega = j == c.heading && c.heading_sign == 1.0;
+        eta.push_back(j == std::min(c.x, c.y) ? "v" : omega ? "omega" : joints[std::size_t(j)]);
+      }
+      k = c.k();
+    }
+    out = describe(m.chain.name(), joints, eta, k, m.chain.gravity());
+  }
+  std::cout << nhdyn::io::dump(out) << '\n';
+  return 0;
+}
+}  // namespace
+
+command command_model() { return {"model", "describe a model: name, dof, joint and eta names, k, gravity", usage, run}; }
+
+}  // namespace nhdyn_tool

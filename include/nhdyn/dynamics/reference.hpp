@@ -1,0 +1,103 @@
+#pragma once
+/// \file dynamics/reference.hpp
+/// The plain reference algorithms on trees, in Featherstone's names and spatial algebra
+/// (Rigid Body Dynamics Algorithms, 2008; "RBDA"): the specification and the test oracle of
+/// the fast kernels (dynamics/tree.hpp), not what they run. Unchecked inputs; any scalar.
+#include <Eigen/Core>
+
+#include "../model/tree.hpp"
+#include "../spatial/spatial.hpp"
+
+namespace nhdyn::reference {
+
+template <class T>
+using vecX = Eigen::Matrix<T, Eigen::Dynamic, 1>;
+template <class T>
+using matX = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>;
+
+/// jcalc and the tree's fixed placements: X_PB(q) = X_PJ · joint(q) · X_JB as (R, p), the body
+/// frame's axes and origin in its parent's frame (RBDA §4.4, X_i = X_J X_T).
+template <class T, class S>
+std::pair<mat3<T>, vec3<T>> placement(const body<S>& b, const T& q) {
+  const vec3<T> u = b.axis.template cast<T>();
+  const mat3<T> RJ = b.joint == joint_type::revolute ? spatial::axis_angle(u, q) : mat3<T>::Identity();
+  const vec3<T> pJ = b.joint == joint_type::prismatic ? vec3<T>(u * q) : vec3<T>::Zero();
+  const mat3<T> R_PJ = b.R_PJ.template cast<T>();
+  return {R_PJ * RJ * b.R_JB.template cast<T>(), b.p_PJ.template cast<T>() + R_PJ * (pJ + RJ * b.p_JB.template cast<T>())};
+}
+
+/// The joint's motion subspace S_i in body coordinates: [u; c × u] for a revolute joint about
+/// the unit axis u through the point c, [0; u] for a prismatic one (RBDA Table 4.1).
+template <class T, class S>
+spatial::vec6<T> motion_subspace(const body<S>& b) {
+  const mat3<T> R_BJ = b.R_JB.template cast<T>().transpose();
+  const vec3<T> u = R_BJ * b.axis.template cast<T>();
+  const vec3<T> c = -(R_BJ * b.p_JB.template cast<T>());
+  spatial::vec6<T> s;
+  if (b.joint == joint_type::revolute)
+    s << u, c.cross(u);
+  else
+    s << vec3<T>::Zero(), u;
+  return s;
+}
+
+/// Inverse dynamics τ = M(q)q̈ + C(q,q̇)q̇ + g(q) by the recursive Newton–Euler algorithm
+/// (RBDA Table 5.1, eqs. 5.7–5.11), gravity as a fictitious base acceleration a_0 = −a_g.
+template <class T, class S>
+vecX<T> rne(const tree<S>& t, const vecX<T>& q, const vecX<T>& qd, const vecX<T>& qdd, bool gravity = true) {
+  using namespace spatial;
+  const int n = t.dof();
+  std::vector<mat6<T>> X(n);  // ^iX_λ(i)
+  std::vector<vec6<T>> Si(n), v(n), a(n), f(n);
+  vec6<T> a0 = vec6<T>::Zero();
+  if (gravity) a0.template tail<3>() = -t.gravity().template cast<T>();
+  for (int i = 0; i < n; ++i) {
+    const auto [R, p] = placement(t[i], q(i));
+    X[i] = motion_transform(R, p);
+    Si[i] = motion_subspace<T>(t[i]);
+    const int l = t.parent(i);
+    const vec6<T> vl = l < 0 ? vec6<T>::Zero() : v[l];
+    const vec6<T> al = l < 0 ? a0 : a[l];
+    v[i] = X[i] * vl + Si[i] * qd(i);                                   // (5.7)
+    a[i] = X[i] * al + Si[i] * qdd(i) + crm(v[i]) * Si[i] * qd(i);     // (5.8)
+    const mat6<T> I = inertia<T>(T(t[i].mass), t[i].com.template cast<T>(), t[i].inertia.template cast<T>());
+    f[i] = I * a[i] + crf(v[i]) * I * v[i];                             // (5.9)
+  }
+  vecX<T> tau(n);
+  for (int i = n - 1; i >= 0; --i) {
+    tau(i) = Si[i].dot(f[i]);                                           // (5.11)
+    if (t.parent(i) >= 0) f[t.parent(i)] += X[i].transpose() * f[i];   // (5.10)
+  }
+  return tau;
+}
+
+/// The joint-space inertia matrix H(q) by the composite-rigid-body algorithm (RBDA Table 6.2):
+/// H_ij = 0 unless one of i, j supports the other (bodies on different branches do not couple).
+template <class T, class S>
+matX<T> crba(const tree<S>& t, const vecX<T>& q) {
+  using namespace spatial;
+  const int n = t.dof();
+  std::vector<mat6<T>> X(n), Ic(n);
+  std::vector<vec6<T>> Si(n);
+  for (int i = 0; i < n; ++i) {
+    const auto [R, p] = placement(t[i], q(i));
+    X[i] = motion_transform(R, p);
+    Si[i] = motion_subspace<T>(t[i]);
+    Ic[i] = inertia<T>(T(t[i].mass), t[i].com.template cast<T>(), t[i].inertia.template cast<T>());
+  }
+  for (int i = n - 1; i >= 0; --i)
+    if (t.parent(i) >= 0) Ic[t.parent(i)] += X[i].transpose() * Ic[i] * X[i];  // composite inertia
+  matX<T> H = matX<T>::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    vec6<T> F = Ic[i] * Si[i];
+    H(i, i) = Si[i].dot(F);
+    for (int j = i; t.parent(j) >= 0;) {
+      F = X[j].transpose() * F;
+      j = t.parent(j);
+      H(i, j) = H(j, i) = F.dot(Si[j]);
+    }
+  }
+  return H;
+}
+
+}  // namespace nhdyn::reference

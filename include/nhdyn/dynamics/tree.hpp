@@ -1,0 +1,305 @@
+#pragma once
+/// \file dynamics/tree.hpp
+/// rne, the mass matrix (CRBA), the bias and the holonomic forward dynamics of a kinematic
+/// tree (model/tree.hpp), as function objects generic over the scalar, with the same call
+/// forms as the chain versions: `rne(t)(q, qd, qdd)`, `mass_matrix(t)(q)`, `bias(t)(q, qd)`,
+/// `forward_dynamics(t)(q, qd, tau)`.
+///
+/// The kernel is the optimisation of the reference algorithms (dynamics/reference.hpp: RBDA
+/// Tables 5.1 and 6.2), tested equal to them. What it changes: each body is computed in its
+/// *kernel frame* K_i, the moved joint frame turned once so that the joint axis is z — the
+/// joint's motion is then Rz(q) or Tz(q), the joint subspace is a unit vector, and every
+/// constant (placement of K_i in K_λ(i), m, m·c, the rotational inertia about K_i's origin) is
+/// computed once when the function object is built. Velocities and forces are 3-vectors in
+/// those frames (the Luh–Walker–Paul form of the same recursion).
+#include <Eigen/Core>
+#include <vector>
+
+#include "../detail/ldlt.hpp"
+#include "../functional/values.hpp"
+#include "../model/tree_kernel.hpp"
+#include "../spatial/spatial.hpp"
+#include "rne.hpp"
+
+namespace nhdyn {
+
+namespace detail {
+
+/// The rne recursion on a tree (links already in T), into tau.
+template <bool Gravity, bool Velocity, class T, class Q, class QD, class QDD, class Tau>
+void tree_rne_kernel(const std::vector<tree_link<T>>& L, const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd,
+                     Tau& tau) {
+  const int n = static_cast<int>(L.size());
+  struct ws {
+    mat3<T> R;
+    vec3<T> w, dw, a, f, m;
+  };
+  std::vector<ws> s(static_cast<std::size_t>(n));
+  const vec3<T> zero = vec3<T>::Zero();
+  const vec3<T> a0 = Gravity ? vec3<T>(-g) : zero;
+  for (int i = 0; i < n; ++i) {
+    const auto& k = L[i];
+    auto& c = s[i];
+    vec3<T> p;
+    kernel_placement(k, T(q(i)), c.R, p);
+    const bool root = k.parent < 0;
+    const vec3<T>& wl = root ? zero : s[k.parent].w;
+    const vec3<T>& dwl = root ? zero : s[k.parent].dw;
+    const vec3<T>& al = root ? a0 : s[k.parent].a;
+    // the origin of K_i moves with the parent: a = a_λ + ω̇_λ × p + ω_λ × (ω_λ × p)
+    vec3<T> ao = al + dwl.cross(p);
+    if (Velocity) ao += wl.cross(wl.cross(p));
+    c.a = c.R.transpose() * ao;
+    c.w = c.R.transpose() * wl;
+    c.dw = c.R.transpose() * dwl;
+    const T qdi = Velocity ? T(qd(i)) : T(0);
+    if (k.revolute) {  // ω̇ += z q̈ + ω_λ × z q̇ (in K_i), ω += z q̇
+      if (Velocity) c.dw += vec3<T>(c.w.y() * qdi, -c.w.x() * qdi, T(0));
+      c.dw.z() += T(qdd(i));
+      if (Velocity) c.w.z() += qdi;
+    } else {  // a += z q̈ + 2 ω × z q̇
+      c.a.z() += T(qdd(i));
+      if (Velocity) c.a += T(2) * qdi * vec3<T>(c.w.y(), -c.w.x(), T(0));
+    }
+    if (k.has_inertia) {  // F = m a + ω̇ × h + ω × (ω × h);  N = I_o ω̇ + ω × I_o ω + h × a
+      c.f = k.m * c.a + c.dw.cross(k.h);
+      c.m = k.Io * c.dw + k.h.cross(c.a);
+      if (Velocity) {
+        c.f += c.w.cross(c.w.cross(k.h));
+        c.m += c.w.cross(k.Io * c.w);
+      }
+    } else {
+      c.f = zero;
+      c.m = zero;
+    }
+  }
+  for (int i = n - 1; i >= 0; --i) {
+    const auto& k = L[i];
+    auto& c = s[i];
+    tau(i) = k.revolute ? c.m.z() : c.f.z();
+    if (k.parent >= 0) {
+      auto& pc = s[k.parent];
+      const vec3<T> f = c.R * c.f;
+      vec3<T> p;
+      if (k.revolute)
+        p = k.p;
+      else
+        p = k.p + k.R.col(2) * T(q(i));
+      pc.f += f;
+      pc.m += c.R * c.m + p.cross(f);
+    }
+  }
+}
+
+/// The composite-rigid-body algorithm on the kernel constants (RBDA Table 6.2 in 3-vector
+/// form: a composite body's m, h, I_o are carried to the parent's frame).
+template <class T, class Q>
+Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> tree_crba_kernel(const std::vector<tree_link<T>>& L, const Q& q) {
+  const int n = static_cast<int>(L.size());
+  std::vector<mat3<T>> R(n), Io(n);
+  std::vector<vec3<T>> p(n), h(n);
+  std::vector<T> m(n);
+  for (int i = 0; i < n; ++i) {
+    kernel_placement(L[i], T(q(i)), R[i], p[i]);
+    m[i] = L[i].m;
+    h[i] = L[i].h;
+    Io[i] = L[i].Io;
+  }
+  // composite inertias, tip to root: in the parent frame, h' = R h + m p,
+  // I_o' = R I_o Rᵀ − m S(p)² − S(p) S(R h) − S(R h) S(p)   (parallel axis, origin moved by p)
+  for (int i = n - 1; i >= 0; --i) {
+    const int l = L[i].parent;
+    if (l < 0) continue;
+    const vec3<T> hr = R[i] * h[i];
+    const mat3<T> P = spatial::skew(p[i]), Hr = spatial::skew(hr);
+    m[l] += m[i];
+    h[l] += hr + m[i] * p[i];
+    Io[l] += R[i] * Io[i] * R[i].transpose() - m[i] * P * P - P * Hr - Hr * P;
+  }
+  Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> H = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    // F = Ic_i S_i as (moment n about K_i's origin, force f), in K_i
+    vec3<T> f, nm;
+    const vec3<T> z(T(0), T(0), T(1));
+    if (L[i].revolute) {
+      f = z.cross(h[i]);  // ω = z: f = ω × h, n = I_o ω
+      nm = Io[i] * z;
+    } else {
+      f = m[i] * z;  // v = z: f = m v, n = h × v
+      nm = h[i].cross(z);
+    }
+    H(i, i) = L[i].revolute ? nm.z() : f.z();
+    for (int j = i; L[j].parent >= 0;) {
+      const vec3<T> fr = R[j] * f;
+      nm = R[j] * nm + p[j].cross(fr);
+      f = fr;
+      j = L[j].parent;
+      H(i, j) = H(j, i) = L[j].revolute ? nm.z() : f.z();
+    }
+  }
+  return H;
+}
+
+}  // namespace detail
+
+/// rne over a tree: `rne(t)(q, qd, qdd)` (see dynamics/rne.hpp for the meaning and options).
+template <class S>
+class tree_rne_fn : public stage_tag {
+ public:
+  using model_scalar = S;
+  static constexpr int size_at_compile_time = dynamic;
+
+  explicit tree_rne_fn(const tree<S>& t, rne_options o = {})
+      : links_(detail::make_tree_links(t)), g_(t.gravity()), n_(t.dof()), opt_(o) {}
+
+  int dof() const { return n_; }
+  rne_options options() const { return opt_; }
+  const vec3<S>& gravity() const { return g_; }
+  tree_rne_fn with(rne_options o) const {
+    tree_rne_fn r = *this;
+    r.opt_ = o;
+    return r;
+  }
+
+  template <class Q, class QD, class QDD>
+    requires scalar<typename Q::Scalar> && scalar<typename QD::Scalar> && scalar<typename QDD::Scalar>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
+                  const Eigen::MatrixBase<QDD>& qdd) const {
+    using T = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>, typename QDD::Scalar>;
+    detail::check_size(q, n_, "q");
+    detail::check_size(qd, n_, "qd");
+    detail::check_size(qdd, n_, "qdd");
+    detail::check_finite(q, "q");
+    if (opt_.velocity) detail::check_finite(qd, "qd");
+    detail::check_finite(qdd, "qdd");
+    vecN<T, dynamic> v(n_);
+    const auto run = [&](const std::vector<detail::tree_link<T>>& L) {
+      const vec3<T> g = g_.template cast<T>();
+      if (opt_.gravity)
+        opt_.velocity ? detail::tree_rne_kernel<true, true, T>(L, g, q, qd, qdd, v)
+                      : detail::tree_rne_kernel<true, false, T>(L, g, q, qd, qdd, v);
+      else
+        opt_.velocity ? detail::tree_rne_kernel<false, true, T>(L, g, q, qd, qdd, v)
+                      : detail::tree_rne_kernel<false, false, T>(L, g, q, qd, qdd, v);
+    };
+    if constexpr (std::is_same_v<T, S>)
+      run(links_);
+    else
+      run(cast_links<T>());
+    detail::check_overflow(v, "rne");
+    return v;
+  }
+
+  /// Pipeline form: ξ = (q, q̇, q̈) → (q, v).
+  template <class X>
+  generalized_forces<promote_t<S, X>, dynamic> operator()(const joint_state<X, dynamic>& xi) const {
+    return {xi.q.template cast<promote_t<S, X>>(), (*this)(xi.q, xi.qd, xi.qdd)};
+  }
+
+  const std::vector<detail::tree_link<S>>& links() const { return links_; }
+
+ private:
+  template <class T>
+  std::vector<detail::tree_link<T>> cast_links() const {
+    std::vector<detail::tree_link<T>> out;
+    out.reserve(links_.size());
+    for (const auto& k : links_) out.push_back(k.template cast<T>());
+    return out;
+  }
+  std::vector<detail::tree_link<S>> links_;
+  vec3<S> g_;
+  int n_;
+  rne_options opt_;
+};
+
+template <class S>
+tree_rne_fn<S> rne(const tree<S>& t, rne_options o = {}) {
+  return tree_rne_fn<S>(t, o);
+}
+
+/// M(q) of a tree by the composite-rigid-body algorithm: `mass_matrix(t)(q)`.
+template <class S>
+class tree_mass_matrix_fn : public stage_tag {
+ public:
+  explicit tree_mass_matrix_fn(const tree<S>& t) : links_(detail::make_tree_links(t)), n_(t.dof()) {}
+  int dof() const { return n_; }
+
+  template <class Q>
+  auto operator()(const Eigen::MatrixBase<Q>& q) const {
+    using T = promote_t<S, typename Q::Scalar>;
+    detail::check_size(q, n_, "q");
+    detail::check_finite(q, "q");
+    if constexpr (std::is_same_v<T, S>) {
+      return detail::tree_crba_kernel<T>(links_, q);
+    } else {
+      std::vector<detail::tree_link<T>> L;
+      for (const auto& k : links_) L.push_back(k.template cast<T>());
+      return detail::tree_crba_kernel<T>(L, q);
+    }
+  }
+
+ private:
+  std::vector<detail::tree_link<S>> links_;
+  int n_;
+};
+
+template <class S>
+tree_mass_matrix_fn<S> mass_matrix(const tree<S>& t) {
+  return tree_mass_matrix_fn<S>(t);
+}
+
+/// h(q, q̇) = C q̇ + g = rne(q, q̇, 0) of a tree: `bias(t)(q, qd)`.
+template <class S>
+class tree_bias_fn : public stage_tag {
+ public:
+  explicit tree_bias_fn(const tree<S>& t, rne_options o = {}) : rne_(t, o) {}
+  template <class Q, class QD>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd) const {
+    return rne_(q, qd, vecN<typename Q::Scalar, dynamic>::Zero(q.size()));
+  }
+
+ private:
+  tree_rne_fn<S> rne_;
+};
+
+template <class S>
+tree_bias_fn<S> bias(const tree<S>& t, rne_options o = {}) {
+  return tree_bias_fn<S>(t, o);
+}
+
+/// Holonomic forward dynamics of a tree, q̈ = M⁻¹(τ − h), M by CRBA, solved by LDLᵀ.
+template <class S>
+class tree_forward_dynamics_fn : public stage_tag {
+ public:
+  explicit tree_forward_dynamics_fn(const tree<S>& t, rne_options o = {}) : M_(t), rne_(t, o) {}
+
+  template <class Q>
+  double mass_matrix_condition(const Eigen::MatrixBase<Q>& q) const {
+    return condition_number(M_(q));
+  }
+
+  template <class Q, class QD, class TAU>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
+                  const Eigen::MatrixBase<TAU>& tau) const {
+    using X = typename Q::Scalar;
+    using T = promote_t<S, X>;
+    detail::check_size(tau, rne_.dof(), "tau");
+    detail::check_finite(tau, "tau");
+    const vecN<T, dynamic> h = rne_(q, qd, vecN<X, dynamic>::Zero(q.size()));
+    const auto f = ldlt_factor<T, dynamic>(M_(q), "the mass matrix M(q)");
+    vecN<T, dynamic> qdd = f.solve(tau.template cast<T>() - h);
+    detail::check_overflow(qdd, "forward_dynamics");
+    return qdd;
+  }
+
+ private:
+  tree_mass_matrix_fn<S> M_;
+  tree_rne_fn<S> rne_;
+};
+
+template <class S>
+tree_forward_dynamics_fn<S> forward_dynamics(const tree<S>& t, rne_options o = {}) {
+  return tree_forward_dynamics_fn<S>(t, o);
+}
+
+}  // namespace nhdyn

@@ -1,0 +1,166 @@
+#pragma once
+/// \file kinematics/tree.hpp
+/// Kinematics of a tree (model/tree.hpp), with the chain kinematics' call forms: poses of
+/// every body frame, the geometric Jacobian and J̇q̇ of a point fixed on a body, all in the
+/// base frame. Body index i: 0 is the base, 1…n the bodies in q order (as a chain's link
+/// frames); named forms take a body's or a merged frame's name.
+///
+///     X_0i = X_0λ(i) · X_λ(i)i(q_i)
+///     J column j (j supports i): revolute (z_j × (p − o_j); z_j), prismatic (z_j; 0);
+///     zero for joints that do not move body i (other branches, and i's descendants).
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "../model/tree_kernel.hpp"
+#include "kinematics.hpp"
+
+namespace nhdyn {
+
+template <class S>
+class tree_kinematics {
+ public:
+  explicit tree_kinematics(const tree<S>& t) : tree_(t), links_(detail::make_tree_links(t)), n_(t.dof()) {}
+  int dof() const { return n_; }
+  const tree<S>& model() const { return tree_; }
+
+  /// Poses of the base (entry 0) and of the n body frames (entries 1…n) in the base frame.
+  template <class Q>
+  auto forward(const Eigen::MatrixBase<Q>& q) const {
+    using T = promote_t<S, typename Q::Scalar>;
+    const auto K = kernel_frames(q);
+    std::vector<pose<T>> X(static_cast<std::size_t>(n_ + 1));
+    for (int i = 0; i < n_; ++i) {
+      const auto& k = links_[std::size_t(i)];
+      X[std::size_t(i + 1)] = {K[i].R * k.R_KB.template cast<T>(), K[i].p + K[i].R * k.p_KB.template cast<T>()};
+    }
+    return X;
+  }
+
+  /// Pose of body frame i (0…n) in the base frame.
+  template <class Q>
+  auto frame(const Eigen::MatrixBase<Q>& q, int i) const {
+    check_body(i);
+    return forward(q)[std::size_t(i)];
+  }
+  /// Pose of the named body or merged frame in the base frame.
+  template <class Q>
+  auto frame(const Eigen::MatrixBase<Q>& q, const std::string& name) const {
+    using T = promote_t<S, typename Q::Scalar>;
+    const auto f = tree_.find_frame(name);
+    const auto X = frame(q, f.body + 1);
+    return pose<T>{X.R * f.R.template cast<T>(), X.p + X.R * f.p.template cast<T>()};
+  }
+
+  /// Position in the base frame of the point p_i (in body i's frame) of body i (0 = base).
+  template <class Q>
+  auto point(const Eigen::MatrixBase<Q>& q, int i, const vec3<S>& p_i = vec3<S>::Zero()) const {
+    using T = promote_t<S, typename Q::Scalar>;
+    check_point(p_i);
+    const auto X = frame(q, i);
+    return vec3<T>(X.p + X.R * p_i.template cast<T>());
+  }
+
+  /// Geometric Jacobian (6×n, rows v then ω, base frame) of point p_i of body i.
+  template <class Q>
+  auto jacobian(const Eigen::MatrixBase<Q>& q, int i, const vec3<S>& p_i = vec3<S>::Zero()) const {
+    using T = promote_t<S, typename Q::Scalar>;
+    check_body(i);
+    check_point(p_i);
+    const auto K = kernel_frames(q);
+    Eigen::Matrix<T, 6, Eigen::Dynamic> J = Eigen::Matrix<T, 6, Eigen::Dynamic>::Zero(6, n_);
+    if (i == 0) return J;
+    const auto& kb = links_[std::size_t(i - 1)];
+    const vec3<T> r = kb.R_KB.template cast<T>() * p_i.template cast<T>() + kb.p_KB.template cast<T>();
+    const vec3<T> p = K[i - 1].p + K[i - 1].R * r;
+    for (int j = i - 1; j >= 0; j = links_[std::size_t(j)].parent) {
+      const vec3<T> z = K[j].R.col(2);
+      if (links_[std::size_t(j)].revolute) {
+        J.col(j).template head<3>() = z.cross(p - K[j].p);
+        J.col(j).template tail<3>() = z;
+      } else {
+        J.col(j).template head<3>() = z;
+      }
+    }
+    return J;
+  }
+
+  /// J̇q̇ of point p_i of body i, in the base frame: its acceleration at q̈ = 0, no gravity.
+  template <class Q, class QD>
+  auto jdot_qdot(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, int i,
+                 const vec3<S>& p_i = vec3<S>::Zero()) const {
+    using T = promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>;
+    check_body(i);
+    detail::check_size(qd, n_, "qd");
+    detail::check_finite(qd, "qd");
+    check_point(p_i);
+    const auto K = kernel_frames(q);
+    point_acceleration<T> out;
+    if (i == 0) return out;
+    // the path from the root to body i, then the velocity recursion of rne along it
+    std::vector<int> path;
+    for (int j = i - 1; j >= 0; j = links_[std::size_t(j)].parent) path.insert(path.begin(), j);
+    vec3<T> w = vec3<T>::Zero(), dw = vec3<T>::Zero(), acc = vec3<T>::Zero();  // in K_j
+    for (int j : path) {
+      const auto k = links_[std::size_t(j)].template cast<T>();
+      mat3<T> R;
+      vec3<T> p;
+      detail::kernel_placement(k, T(q(j)), R, p);
+      acc = R.transpose() * vec3<T>(acc + dw.cross(p) + w.cross(w.cross(p)));
+      w = R.transpose() * w;
+      dw = R.transpose() * dw;
+      const T qdj = T(qd(j));
+      if (k.revolute) {
+        dw += vec3<T>(w.y() * qdj, -w.x() * qdj, T(0));
+        w.z() += qdj;
+      } else {
+        acc += T(2) * qdj * vec3<T>(w.y(), -w.x(), T(0));
+      }
+    }
+    const auto& kb = links_[std::size_t(i - 1)];
+    const vec3<T> r = kb.R_KB.template cast<T>() * p_i.template cast<T>() + kb.p_KB.template cast<T>();
+    out.linear = K[i - 1].R * vec3<T>(acc + dw.cross(r) + w.cross(w.cross(r)));
+    out.angular = K[i - 1].R * dw;
+    return out;
+  }
+
+  /// 1-based body index of a body or frame name (0: the base) and the point on that body of
+  /// the frame's origin, for the index forms above.
+  std::pair<int, vec3<S>> locate(const std::string& name) const {
+    const auto f = tree_.find_frame(name);
+    return {f.body + 1, f.p};
+  }
+
+ private:
+  /// Poses of the kernel frames K_0…K_{n−1} in the base frame.
+  template <class Q>
+  auto kernel_frames(const Eigen::MatrixBase<Q>& q) const {
+    using T = promote_t<S, typename Q::Scalar>;
+    detail::check_size(q, n_, "q");
+    detail::check_finite(q, "q");
+    std::vector<pose<T>> K(static_cast<std::size_t>(n_));
+    for (int i = 0; i < n_; ++i) {
+      const auto k = links_[std::size_t(i)].template cast<T>();
+      mat3<T> R;
+      vec3<T> p;
+      detail::kernel_placement(k, T(q(i)), R, p);
+      if (k.parent < 0)
+        K[i] = {R, p};
+      else
+        K[i] = {K[k.parent].R * R, K[k.parent].p + K[k.parent].R * p};
+    }
+    return K;
+  }
+  static void check_point(const vec3<S>& p_i) {
+    for (int r = 0; r < 3; ++r)
+      if (!is_finite_scalar(p_i(r))) detail::throw_not_finite("p_i", r, value_of(p_i(r)));
+  }
+  void check_body(int i) const {
+    if (i < 0 || i > n_) throw input_error("body index " + std::to_string(i) + " is outside 0…" + std::to_string(n_));
+  }
+  tree<S> tree_;
+  std::vector<detail::tree_link<S>> links_;
+  int n_;
+};
+
+}  // namespace nhdyn

@@ -1,0 +1,216 @@
+// Kinematic trees (model/tree.hpp): the fast kernels (dynamics/tree.hpp, kinematics/tree.hpp)
+// against the plain reference (dynamics/reference.hpp, Featherstone's spatial algebra), the DH
+// chain kernels (a chain is a tree), and physics invariants that neither computes directly.
+#include <catch2/catch.hpp>
+
+#include <nhdyn/dynamics/reference.hpp>
+#include <nhdyn/dynamics/tree.hpp>
+#include <nhdyn/kinematics/tree.hpp>
+#include <nhdyn/nhdyn.hpp>
+#include <nhdyn/scalar/interval.hpp>
+#include <random>
+
+#include "reference/random_tree.hpp"
+
+using namespace nhdyn;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+namespace {
+
+double rel(const MatrixXd& a, const MatrixXd& b) { return (a - b).norm() / std::max(1.0, b.norm()); }
+
+VectorXd random_state(std::mt19937_64& rng, int n, double r = 1.5) {
+  VectorXd v(n);
+  for (int i = 0; i < n; ++i) v(i) = nhdyn_ref::uniform(rng, -r, r);
+  return v;
+}
+
+}  // namespace
+
+TEST_CASE("a DH chain as a tree gives the chain kernels' rne, M and frames", "[tree]") {
+  std::mt19937_64 rng(7);
+  std::vector<chain<double>> chains{presets::paper5_chain().dynamic_size(), presets::puma560().dynamic_size()};
+  for (int k = 0; k < 4; ++k) chains.push_back(nhdyn_ref::random_chain(rng, 3 + 2 * k));
+  for (const auto& c : chains) {
+    const tree<double> t = as_tree(c);
+    const auto rc = rne(c);
+    const auto rt = rne(t);
+    const auto Mc = mass_matrix(c);
+    const auto Mt = mass_matrix(t);
+    const kinematics<double> kc(c);
+    const tree_kinematics<double> kt(t);
+    for (int s = 0; s < 5; ++s) {
+      const VectorXd q = random_state(rng, c.dof()), qd = random_state(rng, c.dof()), qdd = random_state(rng, c.dof());
+      CHECK(rel(rt(q, qd, qdd), rc(q, qd, qdd)) < 1e-13);
+      CHECK(rel(Mt(q), Mc(q)) < 1e-13);
+      const auto Xc = kc.forward(q);
+      const auto Xt = kt.forward(q);
+      for (int i = 1; i <= c.dof(); ++i) {
+        CHECK(rel(Xt[std::size_t(i)].R, Xc[std::size_t(i)].R) < 1e-13);
+        CHECK(rel(Xt[std::size_t(i)].p, Xc[std::size_t(i)].p) < 1e-13);
+      }
+      const Eigen::Vector3d p(0.1, -0.2, 0.3);
+      CHECK(rel(kt.jacobian(q, c.dof(), p), kc.jacobian(q, c.dof(), p)) < 1e-13);
+      const auto ac = kc.jdot_qdot(q, qd, c.dof(), p);
+      const auto at = kt.jdot_qdot(q, qd, c.dof(), p);
+      CHECK(rel(at.linear, ac.linear) < 1e-12);
+      CHECK(rel(at.angular, ac.angular) < 1e-12);
+    }
+  }
+}
+
+TEST_CASE("tree kernels equal the reference on random trees (double)", "[tree]") {
+  std::mt19937_64 rng(11);
+  for (int n : {1, 2, 5, 12, 30, 60}) {
+    const tree<double> t = nhdyn_ref::random_tree(rng, n);
+    const auto id = rne(t);
+    const auto M = mass_matrix(t);
+    for (int s = 0; s < 3; ++s) {
+      const VectorXd q = random_state(rng, n), qd = random_state(rng, n), qdd = random_state(rng, n);
+      const VectorXd ref = reference::rne<double>(t, q, qd, qdd);
+      INFO("n = " << n);
+      CHECK(rel(id(q, qd, qdd), ref) < 1e-12);
+      CHECK(rel(id.with({.gravity = false})(q, qd, qdd), reference::rne<double>(t, q, qd, qdd, false)) < 1e-12);
+      CHECK(rel(id.with({.velocity = false})(q, qd, qdd), reference::rne<double>(t, q, VectorXd::Zero(n), qdd)) < 1e-12);
+      const MatrixXd H = reference::crba<double>(t, q);
+      CHECK(rel(M(q), H) < 1e-12);
+      // bodies on different branches do not couple: exactly zero, in both
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+          if (!t.supports(i, j) && !t.supports(j, i)) {
+            CHECK(M(q)(i, j) == 0.0);
+            CHECK(H(i, j) == 0.0);
+          }
+    }
+  }
+}
+
+TEST_CASE("tree kernels equal the reference for float, duals and intervals", "[tree]") {
+  std::mt19937_64 rng(13);
+  const tree<double> t = nhdyn_ref::random_tree(rng, 9);
+  const int n = t.dof();
+  const VectorXd q = random_state(rng, n), qd = random_state(rng, n), qdd = random_state(rng, n);
+  const VectorXd ref = reference::rne<double>(t, q, qd, qdd);
+
+  SECTION("float") {
+    const tree<float> tf = t.cast<float>();
+    const Eigen::VectorXf v = rne(tf)(q.cast<float>(), qd.cast<float>(), qdd.cast<float>());
+    CHECK(rel(v.cast<double>(), ref) < 2e-4);
+    CHECK(rel(mass_matrix(tf)(q.cast<float>()).cast<double>(), reference::crba<double>(t, q)) < 2e-4);
+  }
+  SECTION("duals: the kernel's derivative is the reference's") {
+    using D = dual<double, 2>;
+    Eigen::Matrix<D, Eigen::Dynamic, 1> qD = q.cast<D>(), qdD = qd.cast<D>(), qddD = qdd.cast<D>();
+    for (int i = 0; i < n; ++i) {
+      qD(i).derivative(0) = qd(i);
+      qdD(i).derivative(1) = 1.0;
+    }
+    const auto v = rne(t)(qD, qdD, qddD);
+    const auto r = reference::rne<D>(t, qD, qdD, qddD);
+    for (int i = 0; i < n; ++i) {
+      CHECK(v(i).value() == Approx(r(i).value()).epsilon(1e-12).margin(1e-12));
+      CHECK(v(i).derivative(0) == Approx(r(i).derivative(0)).epsilon(1e-11).margin(1e-11));
+      CHECK(v(i).derivative(1) == Approx(r(i).derivative(1)).epsilon(1e-11).margin(1e-11));
+    }
+    const auto MD = mass_matrix(t)(qD);
+    const auto HD = reference::crba<D>(t, qD);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) CHECK(MD(i, j).derivative(0) == Approx(HD(i, j).derivative(0)).margin(1e-11));
+  }
+  SECTION("intervals enclose the double result") {
+    const tree<interval> ti = t.cast<interval>();
+    const auto v = rne(ti)(q.cast<interval>(), qd.cast<interval>(), qdd.cast<interval>());
+    for (int i = 0; i < n; ++i) {
+      CHECK(v(i).lower() <= ref(i) + 1e-12 * std::abs(ref(i)));
+      CHECK(v(i).upper() >= ref(i) - 1e-12 * std::abs(ref(i)));
+      CHECK(v(i).upper() - v(i).lower() < 1e-9 * std::max(1.0, std::abs(ref(i))));
+    }
+  }
+}
+
+TEST_CASE("tree dynamics: M q̈ + h = rne, forward dynamics inverts it, gravity and power balance", "[tree]") {
+  std::mt19937_64 rng(17);
+  for (int n : {3, 8, 20}) {
+    const tree<double> t = nhdyn_ref::random_tree(rng, n);
+    const auto id = rne(t);
+    const auto M = mass_matrix(t);
+    const auto h = bias(t);
+    const auto fd = forward_dynamics(t);
+    const tree_kinematics<double> kin(t);
+    const VectorXd q = random_state(rng, n), qd = random_state(rng, n), qdd = random_state(rng, n);
+    const VectorXd tau = id(q, qd, qdd);
+    CHECK(rel(M(q) * qdd + h(q, qd), tau) < 1e-12);
+    CHECK(rel(fd(q, qd, tau), qdd) < 1e-9);
+    // g(q) = −Σ J_cᵀ m g, the Jacobians of the centres of mass from the kinematics
+    VectorXd grav = VectorXd::Zero(n);
+    for (int i = 0; i < n; ++i) {
+      const MatrixXd J = kin.jacobian(q, i + 1, t[i].com);
+      grav -= J.topRows<3>().transpose() * (t[i].mass * t.gravity());
+    }
+    CHECK(rel(id(q, VectorXd::Zero(n), VectorXd::Zero(n)), grav) < 1e-12);
+    // power balance: dE/dt = q̇ᵀτ, E = ½ q̇ᵀ M q̇ − Σ m gᵀ c, differentiated along the motion
+    // with a dual number (M from the composite-rigid-body algorithm, c from the kinematics)
+    using D = dual<double, 1>;
+    Eigen::Matrix<D, Eigen::Dynamic, 1> qD = q.cast<D>(), qdD = qd.cast<D>();
+    for (int i = 0; i < n; ++i) {
+      qD(i).derivative(0) = qd(i);
+      qdD(i).derivative(0) = qdd(i);
+    }
+    D E = D(0.5) * qdD.dot(M(qD) * qdD);
+    const auto X = kin.forward(qD);
+    for (int i = 0; i < n; ++i) {
+      const vec3<D> c = X[std::size_t(i + 1)].p + X[std::size_t(i + 1)].R * t[i].com.cast<D>();
+      E = E - D(t[i].mass) * t.gravity().cast<D>().dot(c);
+    }
+    CHECK(E.derivative(0) == Approx(qd.dot(tau)).epsilon(1e-11));
+  }
+}
+
+TEST_CASE("tree kinematics: J q̇ is the velocity of the point, J̇q̇ its acceleration at q̈ = 0", "[tree]") {
+  std::mt19937_64 rng(19);
+  const tree<double> t = nhdyn_ref::random_tree(rng, 10);
+  const int n = t.dof();
+  const tree_kinematics<double> kin(t);
+  const VectorXd q = random_state(rng, n), qd = random_state(rng, n);
+  using D = dual<double, 1>;
+  Eigen::Matrix<D, Eigen::Dynamic, 1> qD = q.cast<D>();
+  for (int i = 0; i < n; ++i) qD(i).derivative(0) = qd(i);
+  const Eigen::Vector3d p(0.2, 0.1, -0.3);
+  for (int b = 1; b <= n; ++b) {
+    const auto x = kin.point(qD, b, p);
+    const Eigen::Matrix<double, 6, Eigen::Dynamic> J = kin.jacobian(q, b, p);
+    const Eigen::Matrix<D, 6, Eigen::Dynamic> JD = kin.jacobian(qD, b, p);
+    const auto a = kin.jdot_qdot(q, qd, b, p);
+    for (int r = 0; r < 3; ++r) {
+      CHECK(x(r).derivative(0) == Approx((J.row(r) * qd)(0)).margin(1e-12));
+      D jq(0);
+      for (int j = 0; j < n; ++j) jq = jq + JD(r, j) * D(qd(j));
+      CHECK(a.linear(r) == Approx(jq.derivative(0)).margin(1e-11));
+    }
+  }
+  CHECK_THROWS_AS(kin.jacobian(q, n + 1), input_error);
+  CHECK_THROWS_AS(kin.point(VectorXd::Zero(n - 1), 1), input_error);
+}
+
+TEST_CASE("tree validation names the body and the problem", "[tree][errors]") {
+  std::mt19937_64 rng(23);
+  const tree<double> good = nhdyn_ref::random_tree(rng, 4);
+  const auto broken = [&](auto edit) {
+    auto b = good.bodies();
+    edit(b);
+    return tree<double>(b, good.gravity(), "t");
+  };
+  CHECK_THROWS_WITH(broken([](auto& b) { b[2].mass = -1; }), Catch::Contains("body 'body2'") && Catch::Contains("mass is negative"));
+  CHECK_THROWS_WITH(broken([](auto& b) { b[1].axis = Eigen::Vector3d(0, 0, 2); }), Catch::Contains("axis has length 2"));
+  CHECK_THROWS_WITH(broken([](auto& b) { b[3].parent = 3; }), Catch::Contains("topological order"));
+  CHECK_THROWS_WITH(broken([](auto& b) { b[0].p_PJ(1) = NAN; }), Catch::Contains("not finite"));
+  CHECK_THROWS_WITH(broken([](auto& b) { b[0].inertia(2, 2) = -1; }), Catch::Contains("not positive semi-definite"));
+  CHECK_THROWS_WITH(broken([](auto& b) { b[0].inertia = Eigen::Vector3d(0.001, 0.001, 0.01).asDiagonal(); }),
+                    Catch::Contains("triangle inequality by 8.00e-03"));
+  const auto id = rne(good);
+  CHECK_THROWS_AS(id(VectorXd::Zero(3), VectorXd::Zero(4), VectorXd::Zero(4)), input_error);
+  VectorXd q = VectorXd::Zero(4);
+  q(2) = NAN;
+  CHECK_THROWS_WITH(id(q, VectorXd::Zero(4), VectorXd::Zero(4)), Catch::Contains("q[2]"));
+}

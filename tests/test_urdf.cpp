@@ -1,0 +1,261 @@
+// URDF import (io/urdf.hpp): the documented joint order, fixed joints merged, what real robot
+// files carry (warnings, mimic joints, extra tags), errors that name the file and the element,
+// and the dynamics of the loaded tree against Orocos KDL's tree solver, whose tree is built in
+// this file from urdfdom's model (KDL keeps fixed joints as segments: it merges nothing).
+#include <catch2/catch.hpp>
+
+#include <nhdyn/dynamics/reference.hpp>
+#include <nhdyn/dynamics/tree.hpp>
+#include <nhdyn/io/urdf.hpp>
+#include <nhdyn/kinematics/tree.hpp>
+#include <random>
+
+#include "reference/random_tree.hpp"
+
+#ifdef NHDYN_HAVE_KDL
+#include <kdl/jntarray.hpp>
+#include <kdl/tree.hpp>
+#include <kdl/treeidsolver_recursive_newton_euler.hpp>
+#endif
+
+using namespace nhdyn;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+namespace {
+
+double rel(const MatrixXd& a, const MatrixXd& b) { return (a - b).norm() / std::max(1.0, b.norm()); }
+
+VectorXd random_state(std::mt19937_64& rng, int n) {
+  VectorXd v(n);
+  for (int i = 0; i < n; ++i) v(i) = nhdyn_ref::uniform(rng, -1.5, 1.5);
+  return v;
+}
+
+/// Loads text, collecting the warnings.
+tree<double> load(const std::string& text, std::vector<std::string>& warnings, bool strict = false) {
+  io::urdf_options o;
+  o.strict = strict;
+  o.warn = [&](const std::string& w) { warnings.push_back(w); };
+  return io::parse_urdf(text, "test.urdf", o);
+}
+tree<double> load(const std::string& text) {
+  std::vector<std::string> w;
+  auto t = load(text, w);
+  if (!w.empty()) FAIL("unexpected warning: " << w.front());
+  return t;
+}
+
+std::string read(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+#ifdef NHDYN_HAVE_KDL
+// The KDL tree of a URDF, as kdl_parser builds it (ROS's kdl_parser links all of ROS, so the
+// twenty lines are here): a segment per link, fixed joints as Joint::None, inertias moved to
+// the link frame.
+KDL::Frame kdl_frame(const urdf::Pose& p) {
+  return KDL::Frame(KDL::Rotation::Quaternion(p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w),
+                    KDL::Vector(p.position.x, p.position.y, p.position.z));
+}
+void add_children(const urdf::ModelInterface& m, const urdf::LinkConstSharedPtr& link, KDL::Tree& t) {
+  for (const auto& child : link->child_links) {
+    const auto& j = *child->parent_joint;
+    const KDL::Frame F = kdl_frame(j.parent_to_joint_origin_transform);
+    const KDL::Vector axis(j.axis.x, j.axis.y, j.axis.z);
+    KDL::Joint kj(j.name, KDL::Joint::None);
+    if (j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS)
+      kj = KDL::Joint(j.name, F.p, F.M * axis, KDL::Joint::RotAxis);
+    else if (j.type == urdf::Joint::PRISMATIC)
+      kj = KDL::Joint(j.name, F.p, F.M * axis, KDL::Joint::TransAxis);
+    KDL::RigidBodyInertia I = KDL::RigidBodyInertia::Zero();
+    if (child->inertial) {
+      const auto& in = *child->inertial;
+      const KDL::Frame o = kdl_frame(in.origin);
+      const KDL::RotationalInertia urdf_I(in.ixx, in.iyy, in.izz, in.ixy, in.ixz, in.iyz);
+      const KDL::RotationalInertia Ic = (o.M * KDL::RigidBodyInertia(0, KDL::Vector::Zero(), urdf_I)).getRotationalInertia();
+      I = KDL::RigidBodyInertia(in.mass, o.p, Ic);
+    }
+    t.addSegment(KDL::Segment(child->name, kj, F, I), link->name);
+    add_children(m, child, t);
+  }
+}
+
+struct kdl_model {
+  KDL::Tree tree;
+  std::vector<int> qnr;  // KDL's q index of each of nhdyn's joints
+  explicit kdl_model(const std::string& text, const nhdyn::tree<double>& t) {
+    const auto m = urdf::parseURDF(text);
+    REQUIRE(m);
+    tree = KDL::Tree(m->getRoot()->name);
+    add_children(*m, m->getRoot(), tree);
+    for (int i = 0; i < t.dof(); ++i)
+      for (const auto& [name, e] : tree.getSegments())
+        if (GetTreeElementSegment(e).getJoint().getName() == t[i].joint_name) qnr.push_back(int(GetTreeElementQNr(e)));
+    REQUIRE(static_cast<int>(qnr.size()) == t.dof());
+    REQUIRE(static_cast<int>(tree.getNrOfJoints()) == t.dof());
+  }
+  VectorXd rne(const VectorXd& q, const VectorXd& qd, const VectorXd& qdd, const Eigen::Vector3d& g) const {
+    const int n = static_cast<int>(qnr.size());
+    KDL::JntArray kq(n), kqd(n), kqdd(n), tau(n);
+    for (int i = 0; i < n; ++i) {
+      kq(qnr[i]) = q(i);
+      kqd(qnr[i]) = qd(i);
+      kqdd(qnr[i]) = qdd(i);
+    }
+    KDL::TreeIdSolver_RNE solver(tree, KDL::Vector(g.x(), g.y(), g.z()));
+    REQUIRE(solver.CartToJnt(kq, kqd, kqdd, KDL::WrenchMap(), tau) >= 0);
+    VectorXd out(n);
+    for (int i = 0; i < n; ++i) out(i) = tau(qnr[i]);
+    return out;
+  }
+};
+#endif
+
+}  // namespace
+
+TEST_CASE("URDF joint order: movable joints depth-first from the root, siblings in document order", "[urdf]") {
+  const std::string text = R"(<robot name="order">
+    <link name="base"/><link name="torso"/><link name="zeta_arm"/><link name="alpha_arm"/>
+    <link name="zeta_hand"/><link name="camera"/><link name="alpha_hand"/>
+    <joint name="torso_lift" type="prismatic"><parent link="base"/><child link="torso"/><axis xyz="0 0 1"/>
+      <limit lower="0" upper="0.4" effort="500" velocity="0.1"/></joint>
+    <joint name="zz_first" type="continuous"><parent link="torso"/><child link="zeta_arm"/></joint>
+    <joint name="aa_second" type="continuous"><parent link="torso"/><child link="alpha_arm"/></joint>
+    <joint name="alpha_wrist" type="revolute"><parent link="alpha_arm"/><child link="alpha_hand"/><axis xyz="0 1 0"/>
+      <limit lower="-1" upper="1" effort="10" velocity="2"/></joint>
+    <joint name="camera_mount" type="fixed"><parent link="zeta_arm"/><child link="camera"/><origin xyz="0 0 0.1"/></joint>
+    <joint name="zeta_wrist" type="continuous"><parent link="zeta_arm"/><child link="zeta_hand"/></joint>
+  </robot>)";
+  const tree<double> t = load(text);
+  CHECK(t.joint_names() == std::vector<std::string>{"torso_lift", "zz_first", "zeta_wrist", "aa_second", "alpha_wrist"});
+  CHECK(t.root_name() == "base");
+  CHECK(t[2].parent == 1);
+  CHECK(t[4].parent == 3);
+  CHECK(t[0].joint == joint_type::prismatic);
+  CHECK(t[1].continuous);
+  CHECK(t[0].limits.upper == 0.4);
+  CHECK(t[0].limits.effort == 500);
+  CHECK(t[1].axis == Eigen::Vector3d(1, 0, 0));  // URDF's default axis
+  const auto cam = t.find_frame("camera");
+  CHECK(cam.body == 1);
+  CHECK(cam.p == Eigen::Vector3d(0, 0, 0.1));
+  CHECK(t.gravity() == Eigen::Vector3d(0, 0, -9.81));
+}
+
+TEST_CASE("a fixed joint merges its link's inertia into the parent body", "[urdf]") {
+  // two point masses on one body, one through a fixed joint: the merged body's M is exact
+  const std::string text = R"(<robot name="merge">
+    <link name="base"/>
+    <link name="arm"><inertial><origin xyz="1 0 0"/><mass value="2"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+    <link name="tip"><inertial><origin xyz="0 0.5 0"/><mass value="3"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+    <joint name="shoulder" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/></joint>
+    <joint name="weld" type="fixed"><parent link="arm"/><child link="tip"/><origin xyz="1 0 0" rpy="0 0 1.5707963267949"/></joint>
+  </robot>)";
+  const tree<double> t = load(text);
+  REQUIRE(t.dof() == 1);
+  CHECK(t[0].mass == 5);
+  // about the axis: 2·1² + 3·|(1,0,0) + Rz(90°)(0,0.5,0)|² + 0.1 = 2 + 3·(0.5² + 1²) + 0.1
+  const double M = mass_matrix(t)(VectorXd::Zero(1))(0, 0);
+  CHECK(M == Approx(2 + 3 * 0.25 + 0.1).epsilon(1e-12));
+}
+
+TEST_CASE("a file in the style of real robot descriptions loads, warns per link, and strict refuses", "[urdf]") {
+  const std::string path = std::string(NHDYN_SOURCE_DIR) + "/tests/urdf/real_style.urdf";
+  const std::string text = read(path);
+  REQUIRE(!text.empty());
+  std::vector<std::string> warnings;
+  const tree<double> t = load(text, warnings);
+  REQUIRE(warnings.size() == 2);
+  CHECK_THAT(warnings[0], Catch::Contains("link 'antenna_link'") && Catch::Contains("not positive semi-definite") &&
+                              Catch::Contains("used as given"));
+  CHECK_THAT(warnings[1], Catch::Contains("link 'sensor_link'") &&
+                              Catch::Contains("principal moments violate the triangle inequality by 8.00e-03 kg m^2; used as given"));
+  CHECK_THROWS_WITH(load(text, warnings, true), Catch::Contains("test.urdf: link 'antenna_link'") &&
+                                                     Catch::Contains("not positive semi-definite"));
+  // mimic fingers are independent coordinates, and the mimic is kept
+  const int left = [&] {
+    for (int i = 0; i < t.dof(); ++i)
+      if (t[i].joint_name == "gripper_left_finger_joint") return i;
+    return -1;
+  }();
+  REQUIRE(left >= 0);
+  REQUIRE(t[left].mimic);
+  CHECK(t[left].mimic->joint == "gripper_right_finger_joint");
+  CHECK(t[left].mimic->multiplier == -1);
+  CHECK(t[left].damping == 0.5);
+  CHECK(t[left].friction == 0.1);
+  // a massless body and a point mass are fine
+  std::mt19937_64 rng(3);
+  const VectorXd q = random_state(rng, t.dof()), qd = random_state(rng, t.dof()), qdd = random_state(rng, t.dof());
+  CHECK(rel(rne(t)(q, qd, qdd), reference::rne<double>(t, q, qd, qdd)) < 1e-12);
+#ifdef NHDYN_HAVE_KDL
+  const kdl_model kdl(text, t);
+  CHECK(rel(rne(t)(q, qd, qdd), kdl.rne(q, qd, qdd, t.gravity())) < 1e-12);
+#endif
+}
+
+TEST_CASE("URDF errors name the file, the element and the problem", "[urdf][errors]") {
+  const auto robot = [](const std::string& body) { return "<robot name=\"r\">" + body + "</robot>"; };
+  const std::string two_links = R"(<link name="a"/><link name="b"/>)";
+  const auto joint = [](const std::string& type, const std::string& extra = "") {
+    return "<joint name=\"j\" type=\"" + type + "\"><parent link=\"a\"/><child link=\"b\"/>" + extra + "</joint>";
+  };
+  const auto error = [](const std::string& text) {
+    try {
+      io::parse_urdf(text, "robot.urdf");
+    } catch (const model_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  CHECK_THAT(error("<robot name=\"r\">\n<link name=\"a\">\n</robot>"), Catch::Contains("robot.urdf: malformed XML (line"));
+  CHECK_THAT(error(robot(two_links)), Catch::Contains("robot.urdf: not a valid URDF") && Catch::Contains("root"));
+  CHECK_THAT(error(robot(two_links + joint("revolute", "<axis xyz=\"0 0 0\"/><limit effort=\"1\" velocity=\"1\"/>"))),
+             Catch::Contains("joint 'j' (line 1): axis is zero"));
+  CHECK_THAT(error(robot(two_links + joint("continuous", "<axis xyz=\"0 0 2\"/>"))), Catch::Contains("axis has length 2, not 1"));
+  CHECK_THAT(error(robot(two_links + joint("floating"))), Catch::Contains("type 'floating' is not supported") &&
+                                                               Catch::Contains("\"base\": {\"type\": \"planar\"}"));
+  CHECK_THAT(error(robot(two_links + joint("planar", "<axis xyz=\"0 0 1\"/>"))), Catch::Contains("type 'planar' is not supported"));
+  CHECK_THAT(error(robot("<link name=\"a\"/><link name=\"b\"><inertial><mass value=\"-1\"/><inertia ixx=\"1\" ixy=\"0\" "
+                         "ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>" +
+                         joint("continuous"))),
+             Catch::Contains("link 'b' (line 1)") && Catch::Contains("mass is negative"));
+  CHECK_THAT(error(robot("<link name=\"a\"/><link name=\"b\"><inertial><mass value=\"nan\"/><inertia ixx=\"1\" ixy=\"0\" "
+                         "ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>" +
+                         joint("continuous"))),
+             Catch::Contains("robot.urdf: ") && (Catch::Contains("not finite") || Catch::Contains("mass")));
+  CHECK_THAT(error(robot(two_links + "<joint name=\"j\" type=\"continuous\"><parent link=\"x\"/><child link=\"b\"/></joint>")),
+             Catch::Contains("robot.urdf: not a valid URDF"));
+  CHECK_THAT(error(robot(two_links + joint("fixed"))), Catch::Contains("no movable joint"));
+  CHECK_THROWS_WITH(io::load_urdf("/nonexistent/robot.urdf"), Catch::Contains("/nonexistent/robot.urdf: cannot open"));
+}
+
+TEST_CASE("random URDF trees: the loader's tree agrees with the reference and with KDL's tree solver", "[urdf][kdl]") {
+  std::mt19937_64 rng(29);
+  for (int n : {1, 2, 5, 12, 24, 48, 60}) {
+    const std::string text = nhdyn_ref::random_urdf(rng, n);
+    const tree<double> t = load(text);
+    REQUIRE(t.dof() == n);
+    const auto id = rne(t);
+    const auto M = mass_matrix(t);
+    for (int s = 0; s < 2; ++s) {
+      const VectorXd q = random_state(rng, n), qd = random_state(rng, n), qdd = random_state(rng, n);
+      INFO("n = " << n);
+      const VectorXd tau = id(q, qd, qdd);
+      CHECK(rel(tau, reference::rne<double>(t, q, qd, qdd)) < 1e-12);
+#ifdef NHDYN_HAVE_KDL
+      const kdl_model kdl(text, t);
+      CHECK(rel(tau, kdl.rne(q, qd, qdd, t.gravity())) < 1e-12);
+      MatrixXd Mk(n, n);
+      for (int j = 0; j < n; ++j) Mk.col(j) = kdl.rne(q, VectorXd::Zero(n), VectorXd::Unit(n, j), Eigen::Vector3d::Zero());
+      CHECK(rel(M(q), Mk) < 1e-12);
+      const VectorXd tk = kdl.rne(q, qd, VectorXd::Zero(n), t.gravity());
+      CHECK(rel(forward_dynamics(t)(q, qd, tau), Mk.ldlt().solve(tau - tk)) < 1e-9);
+#endif
+    }
+  }
+}
