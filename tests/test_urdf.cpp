@@ -8,6 +8,7 @@
 #include <nhdyn/dynamics/tree.hpp>
 #include <nhdyn/io/urdf.hpp>
 #include <nhdyn/kinematics/tree.hpp>
+#include <nhdyn/nhdyn.hpp>
 #include <random>
 
 #include "reference/random_tree.hpp"
@@ -257,5 +258,52 @@ TEST_CASE("random URDF trees: the loader's tree agrees with the reference and wi
       CHECK(rel(forward_dynamics(t)(q, qd, tau), Mk.ldlt().solve(tau - tk)) < 1e-9);
 #endif
     }
+  }
+}
+
+TEST_CASE("shipped URDFs: paper5 and puma560 written as URDF give the DH presets' rne and M to 1e-12", "[urdf]") {
+  const std::string dir = std::string(NHDYN_SOURCE_DIR) + "/examples/urdf/";
+  std::mt19937_64 rng(31);
+  const auto check = [&](const chain<double>& c, const std::string& file, std::vector<std::string> expected_warnings) {
+    std::vector<std::string> warnings;
+    io::urdf_options o;
+    o.gravity = c.gravity();  // a URDF carries no gravity; paper5's is along −x₀
+    o.warn = [&](const std::string& w) { warnings.push_back(w); };
+    const tree<double> t = io::load_urdf(dir + file, o);
+    REQUIRE(t.dof() == c.dof());
+    REQUIRE(warnings.size() == expected_warnings.size());
+    for (std::size_t k = 0; k < warnings.size(); ++k) CHECK_THAT(warnings[k], Catch::Contains(expected_warnings[k]));
+    for (int s = 0; s < 10; ++s) {
+      const VectorXd q = random_state(rng, c.dof()), qd = random_state(rng, c.dof()), qdd = random_state(rng, c.dof());
+      CHECK(rel(rne(t)(q, qd, qdd), rne(c)(q, qd, qdd)) < 1e-12);
+      CHECK(rel(mass_matrix(t)(q), mass_matrix(c)(q)) < 1e-12);
+    }
+  };
+  // the Puma's links 1 and 3 break the triangle inequality as published (Corke's parameters)
+  check(presets::puma560().dynamic_size(), "puma560.urdf", {"link 'link1'", "link 'link3'"});
+  check(presets::paper5_chain().dynamic_size(), "paper5.urdf", {});
+}
+
+TEST_CASE("the shipped mobile manipulator: 16 joints in the documented order, physical, equal to KDL", "[urdf][kdl]") {
+  const std::string file = std::string(NHDYN_SOURCE_DIR) + "/examples/urdf/mobile_manipulator.urdf";
+  io::urdf_options strict;
+  strict.strict = true;  // every inertia is a solid box's or cylinder's
+  const tree<double> t = io::load_urdf(file, strict);
+  CHECK(t.joint_names() ==
+        std::vector<std::string>{"wheel_left_joint", "wheel_right_joint", "caster_front_swivel_joint",
+                                 "caster_front_wheel_joint", "caster_rear_swivel_joint", "caster_rear_wheel_joint",
+                                 "torso_lift_joint", "arm_1_joint", "arm_2_joint", "arm_3_joint", "arm_4_joint",
+                                 "arm_5_joint", "arm_6_joint", "arm_7_joint", "head_pan_joint", "head_tilt_joint"});
+  CHECK(t.find_frame("tool_frame").body == t.body_index("arm_7_link"));
+  std::mt19937_64 rng(37);
+  const int n = t.dof();
+  for (int s = 0; s < 5; ++s) {
+    const VectorXd q = random_state(rng, n), qd = random_state(rng, n), qdd = random_state(rng, n);
+    const VectorXd tau = rne(t)(q, qd, qdd);
+    CHECK(rel(tau, reference::rne<double>(t, q, qd, qdd)) < 1e-12);
+#ifdef NHDYN_HAVE_KDL
+    const kdl_model kdl(read(file), t);
+    CHECK(rel(tau, kdl.rne(q, qd, qdd, t.gravity())) < 1e-12);
+#endif
   }
 }
