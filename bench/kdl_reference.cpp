@@ -9,7 +9,10 @@
 #include <kdl/rigidbodyinertia.hpp>
 #include <kdl/rotationalinertia.hpp>
 #include <kdl/segment.hpp>
+#include <kdl/tree.hpp>
+#include <kdl/treeidsolver_recursive_newton_euler.hpp>
 #include <memory>
+#include <string>
 
 namespace nhdyn_bench::kdl {
 
@@ -51,6 +54,48 @@ void set_state(solver* s, const double* q, const double* qd, const double* qdd) 
 int run(solver* s) { return s->id->CartToJnt(s->q, s->qd, s->qdd, s->f_ext, s->tau); }
 
 void torques(const solver* s, double* tau) {
+  for (unsigned i = 0; i < s->tau.rows(); ++i) tau[i] = s->tau(i);
+}
+
+struct tree_solver {
+  KDL::Tree tree{"root"};
+  std::unique_ptr<KDL::TreeIdSolver_RNE> id;
+  KDL::JntArray q, qd, qdd, tau;
+  KDL::WrenchMap f_ext;
+};
+
+tree_solver* make_tree(const tree_body* bodies, int n, const double g[3]) {
+  auto* s = new tree_solver;
+  for (int i = 0; i < n; ++i) {
+    const tree_body& b = bodies[i];
+    const KDL::Frame F(KDL::Rotation(b.R[0], b.R[1], b.R[2], b.R[3], b.R[4], b.R[5], b.R[6], b.R[7], b.R[8]),
+                       KDL::Vector(b.p[0], b.p[1], b.p[2]));
+    const std::string name = "b" + std::to_string(i);
+    const KDL::Joint j(name, F.p, F.M * KDL::Vector(b.axis[0], b.axis[1], b.axis[2]),
+                       b.prismatic ? KDL::Joint::TransAxis : KDL::Joint::RotAxis);
+    const double* I = b.inertia;
+    const KDL::RigidBodyInertia rbi(b.mass, KDL::Vector(b.com[0], b.com[1], b.com[2]),
+                                    KDL::RotationalInertia(I[0], I[4], I[8], I[1], I[2], I[5]));
+    s->tree.addSegment(KDL::Segment(name, j, F, rbi), b.parent < 0 ? "root" : "b" + std::to_string(b.parent));
+  }
+  s->id = std::make_unique<KDL::TreeIdSolver_RNE>(s->tree, KDL::Vector(g[0], g[1], g[2]));
+  s->q = s->qd = s->qdd = s->tau = KDL::JntArray(static_cast<unsigned>(n));
+  return s;
+}
+
+void destroy_tree(tree_solver* s) { delete s; }
+
+void set_tree_state(tree_solver* s, const double* q, const double* qd, const double* qdd) {
+  for (unsigned i = 0; i < s->q.rows(); ++i) {
+    s->q(i) = q[i];
+    s->qd(i) = qd[i];
+    s->qdd(i) = qdd[i];
+  }
+}
+
+int run_tree(tree_solver* s) { return s->id->CartToJnt(s->q, s->qd, s->qdd, s->f_ext, s->tau); }
+
+void tree_torques(const tree_solver* s, double* tau) {
   for (unsigned i = 0; i < s->tau.rows(); ++i) tau[i] = s->tau(i);
 }
 

@@ -29,4 +29,26 @@ int run(solver* s);
 /// Copies the last result out.
 void torques(const solver* s, double* tau);
 
+/// One body of a kinematic tree (nhdyn's tree<double> with identity body offsets, as URDF
+/// gives): its parent (−1: the root), the joint frame in the parent's (R row-major, p), the
+/// unit axis in the joint frame, and the rigid-body parameters in the body (= joint) frame.
+struct tree_body {
+  int parent;
+  bool prismatic;
+  double R[9], p[3], axis[3];
+  double mass;
+  double com[3];
+  double inertia[9];
+};
+
+struct tree_solver;  // opaque
+
+/// Builds a KDL::Tree (one segment per body, added in the given order, so KDL's q index of
+/// body i is i) and its TreeIdSolver_RNE.
+tree_solver* make_tree(const tree_body* bodies, int n, const double gravity[3]);
+void destroy_tree(tree_solver* s);
+void set_tree_state(tree_solver* s, const double* q, const double* qd, const double* qdd);
+int run_tree(tree_solver* s);
+void tree_torques(const tree_solver* s, double* tau);
+
 }  // namespace nhdyn_bench::kdl

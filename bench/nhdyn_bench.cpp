@@ -6,6 +6,9 @@
 ///                                               timed in alternating blocks (counter `ratio`)
 ///   scene/<model>/<variant>                     "model only what a scene requires"
 ///   nh_inertia/<model>/{crba, rne_columns}      M_η = SᵀMS two ways
+///   rne/<tree>/{nhdyn, reference, kdl}          rne on kinematic trees (the kernel, the plain
+///   crba/<tree>/{nhdyn, reference}               spatial-algebra reference, KDL's tree solver);
+///                                               mass matrix by the kernel and the reference
 /// Every case checks its answer once, untimed, against an independent computation (KDL, the
 /// Lagrangian, the run-time-sized variant) and aborts on disagreement; every case reports
 /// `allocs_per_call`, the heap allocations of one call (counted by alloc_counter.cpp).
@@ -17,6 +20,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+
+#include <nhdyn/dynamics/reference.hpp>
+#include <nhdyn/dynamics/tree.hpp>
+#ifdef NHDYN_BENCH_URDF
+#include <nhdyn/io/urdf.hpp>
+#endif
+#include <reference/random_tree.hpp>
 
 #include "alloc_counter.hpp"
 #include "lagrange.hpp"
@@ -290,6 +300,65 @@ void register_scene(const std::string& model, const chain<double>& cd) {
   if (n > 8) id_case("half_arm_massless", nhdyn::inverse_dynamics(half_arm_massless(cd).fixed<N>(), con));
 }
 
+// ------------------------------------------------------ issue 13: trees vs KDL's tree solver
+
+void register_tree(const std::string& model, const nhdyn::tree<double>& t) {
+  const int n = t.dof();
+  const state s = random_state(n);
+  const auto id = nhdyn::rne(t);
+  const auto M = nhdyn::mass_matrix(t);
+  const Eigen::VectorXd tau = id(s.q, s.qd, s.qdd);
+  agree(tau, nhdyn::reference::rne<double>(t, s.q, s.qd, s.qdd), 1e-12, "rne/" + model + ": kernel vs reference");
+  const Eigen::MatrixXd H = nhdyn::reference::crba<double>(t, s.q);
+  agree(Eigen::Map<const Eigen::VectorXd>(M(s.q).eval().data(), n * n), Eigen::Map<const Eigen::VectorXd>(H.data(), n * n),
+        1e-12, "crba/" + model + ": kernel vs reference");
+  add("rne/" + model + "/nhdyn", [id, s]() mutable {
+    opaque(s.q), opaque(s.qd), opaque(s.qdd);
+    auto v = id(s.q, s.qd, s.qdd);
+    benchmark::DoNotOptimize(v);
+  });
+  add("rne/" + model + "/reference", [t, s]() mutable {
+    opaque(s.q), opaque(s.qd), opaque(s.qdd);
+    auto v = nhdyn::reference::rne<double>(t, s.q, s.qd, s.qdd);
+    benchmark::DoNotOptimize(v);
+  });
+  add("crba/" + model + "/nhdyn", [M, s]() mutable {
+    opaque(s.q);
+    auto H = M(s.q);
+    benchmark::DoNotOptimize(H);
+  });
+  add("crba/" + model + "/reference", [t, s]() mutable {
+    opaque(s.q);
+    auto H = nhdyn::reference::crba<double>(t, s.q);
+    benchmark::DoNotOptimize(H);
+  });
+  std::vector<kdl::tree_body> bodies(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const auto& b = t[i];
+    if (!b.R_JB.isIdentity(0) || !b.p_JB.isZero(0)) fail("rne/" + model + ": body offsets are not passed to KDL");
+    auto& k = bodies[std::size_t(i)];
+    k.parent = b.parent;
+    k.prismatic = b.joint == nhdyn::joint_type::prismatic;
+    for (int r = 0; r < 3; ++r) {
+      k.p[r] = b.p_PJ(r);
+      k.axis[r] = b.axis(r);
+      k.com[r] = b.com(r);
+      for (int c = 0; c < 3; ++c) {
+        k.R[3 * r + c] = b.R_PJ(r, c);
+        k.inertia[3 * r + c] = b.inertia(r, c);
+      }
+    }
+    k.mass = b.mass;
+  }
+  std::shared_ptr<kdl::tree_solver> k(kdl::make_tree(bodies.data(), n, t.gravity().data()), kdl::destroy_tree);
+  kdl::set_tree_state(k.get(), s.q.data(), s.qd.data(), s.qdd.data());
+  if (kdl::run_tree(k.get()) != 0) fail("rne/" + model + ": KDL's tree solver returned an error");
+  Eigen::VectorXd tau_k(n);
+  kdl::tree_torques(k.get(), tau_k.data());
+  agree(tau, tau_k, 1e-10, "rne/" + model + ": nhdyn vs KDL TreeIdSolver_RNE");
+  add("rne/" + model + "/kdl", [k]() { benchmark::DoNotOptimize(kdl::run_tree(k.get())); });
+}
+
 }  // namespace
 }  // namespace nhdyn_bench
 
@@ -320,6 +389,13 @@ int main(int argc, char** argv) {
 
   register_scene<5>("paper5", p5);
   register_scene<27>("ddrive_arm24", ddrive_arm(24));
+
+#ifdef NHDYN_BENCH_URDF
+  register_tree("mobile_manipulator", nhdyn::io::load_urdf(NHDYN_SOURCE_DIR "/examples/urdf/mobile_manipulator.urdf"));
+#endif
+  std::mt19937_64 tree_rng(41);
+  for (int n : {12, 24, 48})  // branching trees, URDF-like (no body offsets)
+    register_tree("tree" + std::to_string(n), nhdyn_ref::random_tree(tree_rng, n, 0.4, false));
 
   benchmark::AddCustomContext("nhdyn_compiler", NHDYN_BENCH_CXX);
   benchmark::AddCustomContext("nhdyn_flags", NHDYN_BENCH_FLAGS);

@@ -6,3 +6,8 @@ if(Python3_Interpreter_FOUND)
 else()
   message(STATUS "nhdyn: no Python 3 interpreter, the docs_links test is not built")
 endif()
+# ctest "layers": no header includes one from a layer above its own (tests/docs/check_layers.py
+# lists the layers).
+if(Python3_Interpreter_FOUND)
+  add_test(NAME layers COMMAND Python3::Interpreter ${CMAKE_CURRENT_SOURCE_DIR}/docs/check_layers.py ${PROJECT_SOURCE_DIR})
+endif()

@@ -542,3 +542,31 @@ TEST_CASE("constraints: a constraint over the wrong number of joints, or a wrong
   CHECK_THROWS_WITH(user.A(Vec::Zero(6)), Catch::Contains("q has 6 entries"));
   CHECK_THROWS_WITH(user.Sdot(Vec::Zero(5), Vec::Zero(3)), Catch::Contains("qd has 3 entries"));
 }
+
+namespace concept_check {
+struct no_sdot {  // A and S but no Ṡ: not a constraint
+  static constexpr int n_at_compile_time = nhdyn::dynamic, k_at_compile_time = nhdyn::dynamic,
+                       m_at_compile_time = nhdyn::dynamic;
+  int dof() const { return 2; }
+  int k() const { return 1; }
+  int m() const { return 1; }
+  template <class Q>
+  Eigen::MatrixXd A(const Q&) const { return Eigen::MatrixXd::Zero(1, 2); }
+  template <class Q>
+  Eigen::MatrixXd S(const Q&) const { return Eigen::MatrixXd::Zero(2, 1); }
+};
+}  // namespace concept_check
+
+TEST_CASE("constraint types model the pfaffian_constraint concept; others do not") {
+  STATIC_REQUIRE(nhdyn::pfaffian_constraint<nhdyn::differential_drive<double, 5>>);
+  STATIC_REQUIRE(nhdyn::pfaffian_constraint<nhdyn::differential_drive<double>>);
+  STATIC_REQUIRE(nhdyn::pfaffian_constraint<nhdyn::holonomic<6>>);
+  STATIC_REQUIRE(nhdyn::pfaffian_constraint<nhdyn::holonomic<>>);
+  const auto fA = [](const auto& q) { return Eigen::Matrix<typename std::decay_t<decltype(q)>::Scalar, -1, -1>::Zero(1, 2).eval(); };
+  const auto fS = [](const auto& q) { return Eigen::Matrix<typename std::decay_t<decltype(q)>::Scalar, -1, -1>::Identity(2, 1).eval(); };
+  STATIC_REQUIRE(nhdyn::pfaffian_constraint<decltype(nhdyn::make_constraint(2, 1, fA, fS))>);
+  STATIC_REQUIRE_FALSE(nhdyn::pfaffian_constraint<concept_check::no_sdot>);
+  STATIC_REQUIRE_FALSE(nhdyn::pfaffian_constraint<int>);
+  STATIC_REQUIRE(nhdyn::has_input_map<decltype(nhdyn::make_constraint(2, 1, fA, fS, nullptr, fS)), Eigen::VectorXd>);
+  STATIC_REQUIRE_FALSE(nhdyn::has_input_map<nhdyn::differential_drive<double>, Eigen::VectorXd>);
+}

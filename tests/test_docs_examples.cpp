@@ -8,7 +8,11 @@
 #include <nhdyn/analysis/bounds.hpp>
 #include <nhdyn/analysis/linearize.hpp>
 #include <nhdyn/io/json.hpp>
+#include <nhdyn/kinematics/tree.hpp>
 #include <nhdyn/nhdyn.hpp>
+#ifdef NHDYN_HAVE_URDF
+#include <nhdyn/io/urdf.hpp>
+#endif
 #include <numbers>
 #include <random>
 #include <string>
@@ -126,6 +130,34 @@ TEST_CASE("docs/api.md §2: a chain built from DH rows and rigid-body parameters
   const vec2 v2 = nhdyn::rne(arm2)(vec2(q), vec2(qd), vec2(qdd));
   CHECK(rel(v2, v) < 1e-15);
 }
+
+#ifdef NHDYN_HAVE_URDF
+TEST_CASE("docs/api.md §2: a URDF tree: gravity torques, branch-sparse M, a merged frame, a DH chain as a tree") {
+  const std::string dir = NHDYN_SOURCE_DIR;
+  // snippet (the path made absolute: the test runs in any folder)
+  const nhdyn::tree<double> arm = nhdyn::io::load_urdf(dir + "/examples/urdf/mobile_manipulator.urdf");
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(arm.dof());
+  const Eigen::VectorXd g = nhdyn::rne(arm)(q, q, q);            // gravity torques
+  const Eigen::MatrixXd M = nhdyn::mass_matrix(arm)(q);            // CRBA, branch-sparse
+  const nhdyn::tree_kinematics<double> kin(arm);
+  const auto tool = kin.frame(q, "tool_frame");                    // a merged fixed link, by name
+  const auto t5 = nhdyn::as_tree(nhdyn::presets::paper5_chain());  // a DH chain is a tree
+  // end snippet
+  CHECK(arm.dof() == 16);
+  // gravity torques = −Σ J_cᵀ m g, from the kinematics
+  Eigen::VectorXd grav = Eigen::VectorXd::Zero(arm.dof());
+  for (int i = 0; i < arm.dof(); ++i)
+    grav -= kin.jacobian(q, i + 1, arm[i].com).topRows<3>().transpose() * (arm[i].mass * arm.gravity());
+  CHECK(rel(g, grav) < 1e-12);
+  // the arm and the head are on different branches: they do not couple
+  CHECK(M(arm.body_index("arm_1_link"), arm.body_index("head_pan_link")) == 0.0);
+  // the tool frame is 0.08 + 0.15 m along arm_7_link's z axis
+  const auto a7 = kin.frame(q, "arm_7_link");
+  CHECK(rel(tool.p, a7.p + a7.R * Eigen::Vector3d(0, 0, 0.23)) < 1e-15);
+  const Eigen::VectorXd q5 = Eigen::VectorXd::LinSpaced(5, 0.1, 0.9);
+  CHECK(rel(nhdyn::rne(t5)(q5, q5, q5), nhdyn::rne(nhdyn::presets::paper5_chain())(q5, q5, q5)) < 1e-13);
+}
+#endif
 
 TEST_CASE("docs/api.md §2: an unphysical link is refused with a message naming the model, link and field") {
   // snippet

@@ -286,7 +286,7 @@ TEST_CASE("rne: float and long double agree with the long double Lagrangian at t
 
 TEST_CASE("rne: joint angles far from zero and long chains agree with the independent Lagrangian") {
   // Angles up to 1e6 rad (argument reduction of sin/cos is exercised) on puma560 and random
-  // chains. nhdyn forms θ_i = θ_i⁰ + q_i with a compensated (exact) sum (detail/dh.hpp,
+  // chains. nhdyn forms θ_i = θ_i⁰ + q_i with a compensated (exact) sum (model/dh_kernel.hpp,
   // correct_angle_sum), so the reference sums the given doubles θ_i⁰ and q_i in long double
   // (error ≤ ulp_ld(1e6) ≈ 1e-13 rad): a double-rounded sum would be off by up to
   // ½ulp(q_i) = 6e-11 rad at 1e6 and this test would see it.

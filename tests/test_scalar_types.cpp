@@ -209,7 +209,7 @@ TEMPLATE_TEST_CASE("scalars: power balance, the actuators' power is dE/dt, for e
   const auto q = to<S>(st.q);
   const auto eta = to<S>(st.eta), etad = to<S>(st.eta_dot);
   // τ from the same model the energy uses (the chain in dual<S, 1>, zero derivative parts):
-  // a real type may snap cos α ≈ 6e-17 to 0 where a dual keeps it (detail/dh.hpp), and in 50
+  // a real type may snap cos α ≈ 6e-17 to 0 where a dual keeps it (model/dh_kernel.hpp), and in 50
   // digits that model difference would show.
   const auto withfD = nhdyn::inverse_dynamics_with_forces(r.chain.template cast<D>(), r.constraint)(q, eta, etad);
   struct {
@@ -258,7 +258,7 @@ TEST_CASE("scalars: the 50-digit rne, the reference of this suite, agrees with t
   // Cross-check of the reference itself: tests/reference/lagrangian.hpp (M from link
   // Jacobians, Christoffel symbols of ∂M/∂q, gravity from the potential energy; no algorithm
   // shared with the library) evaluated in mp50. nhdyn takes a twist within 1e-15 of a
-  // multiple of π/2 as exact (detail/dh.hpp); the reference gets the same α to 50 digits.
+  // multiple of π/2 as exact (model/dh_kernel.hpp); the reference gets the same α to 50 digits.
   using nhdyn::mp50;
   const auto exact_twists = [](nhdyn_ref::model<mp50> m) {
     const mp50 half_pi = boost::math::constants::half_pi<mp50>();

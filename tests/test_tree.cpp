@@ -3,6 +3,8 @@
 // chain kernels (a chain is a tree), and physics invariants that neither computes directly.
 #include <catch2/catch.hpp>
 
+#include <nhdyn/analysis/bounds.hpp>
+#include <nhdyn/analysis/linearize.hpp>
 #include <nhdyn/dynamics/reference.hpp>
 #include <nhdyn/dynamics/tree.hpp>
 #include <nhdyn/kinematics/tree.hpp>
@@ -213,4 +215,118 @@ TEST_CASE("tree validation names the body and the problem", "[tree][errors]") {
   VectorXd q = VectorXd::Zero(4);
   q(2) = NAN;
   CHECK_THROWS_WITH(id(q, VectorXd::Zero(4), VectorXd::Zero(4)), Catch::Contains("q[2]"));
+}
+
+TEST_CASE("the nonholonomic stages run on trees: project ∘ rne ∘ lift, λ and the constrained forward dynamics", "[tree][nonholonomic]") {
+  // paper5 as a tree, then a tree with the same base and a branching arm: the composition on
+  // the tree equals the chain's (paper5) and inverts the constrained forward dynamics.
+  std::mt19937_64 rng(43);
+  const auto robot = presets::paper5();
+  const chain<double> ch = robot.chain.dynamic_size();
+  const differential_drive<double> dd(5, 0, 1, 2, 0.0, -1.0);
+  const tree<double> t = as_tree(ch);
+  for (int s = 0; s < 5; ++s) {
+    const VectorXd q = random_state(rng, 5), eta = random_state(rng, 4), eta_dot = random_state(rng, 4);
+    const VectorXd tau_t = inverse_dynamics(t, dd)(q, eta, eta_dot);
+    const VectorXd tau_c = inverse_dynamics(ch, dd)(q, eta, eta_dot);
+    CHECK(rel(tau_t, tau_c) < 1e-13);
+    CHECK(rel(inverse_dynamics(t, robot.constraint)(q, eta, eta_dot), tau_c) < 1e-13);  // compile-time-sized constraint
+    const auto f_t = inverse_dynamics_with_forces(t, dd)(q, eta, eta_dot);
+    const auto f_c = inverse_dynamics_with_forces(ch, dd)(q, eta, eta_dot);
+    CHECK(rel(f_t.lambda, f_c.lambda) < 1e-13);
+    CHECK(rel(nh_forward_dynamics(t, dd)(q, eta, tau_t), eta_dot) < 1e-10);
+  }
+  // a base (x, y prismatic, heading revolute) carrying two branches
+  std::vector<body<double>> B = {t[0], t[1], t[2]};
+  const tree<double> arms = nhdyn_ref::random_tree(rng, 6);
+  for (int i = 0; i < arms.dof(); ++i) {
+    body<double> b = arms[i];
+    b.parent = b.parent < 0 ? 2 : b.parent + 3;
+    B.push_back(b);
+  }
+  const tree<double> mm(B, Eigen::Vector3d(0, 0, -9.81), "base with branches");
+  const differential_drive<double> c(mm.dof(), 0, 1, 2);
+  const auto id = inverse_dynamics(mm, c);
+  const auto fd = nh_forward_dynamics(mm, c);
+  for (int s = 0; s < 3; ++s) {
+    const VectorXd q = random_state(rng, mm.dof()), eta = random_state(rng, c.m()), eta_dot = random_state(rng, c.m());
+    const VectorXd tau = id(q, eta, eta_dot);
+    // τ = Sᵀ(M S η̇ + rne(q, Sη, Ṡη)) from the mass matrix and the holonomic rne: a second route
+    const MatrixXd S = c.S(q);
+    const VectorXd qd = S * eta, qdd = S * eta_dot + c.Sdot(q, qd) * eta;
+    CHECK(rel(tau, S.transpose() * (mass_matrix(mm)(q) * qdd + bias(mm)(q, qd))) < 1e-12);
+    CHECK(rel(fd(q, eta, tau), eta_dot) < 1e-10);
+  }
+}
+
+TEST_CASE("the linearizers run on trees: the chain's numbers on paper5, central differences on a branching robot", "[tree][linearize]") {
+  std::mt19937_64 rng(47);
+  const chain<double> ch = presets::paper5_chain().dynamic_size();
+  const differential_drive<double> dd(5, 0, 1, 2, 0.0, -1.0);
+  const tree<double> t = as_tree(ch);
+  const VectorXd q = random_state(rng, 5), eta = random_state(rng, 4), eta_dot = random_state(rng, 4);
+  const auto Jt = linearize_inverse_dynamics(t, dd, q, eta, eta_dot);
+  const auto Jc = linearize_inverse_dynamics(ch, dd, q, eta, eta_dot);
+  CHECK(rel(Jt.J, Jc.J) < 1e-12);
+  const VectorXd tau = inverse_dynamics(t, dd)(q, eta, eta_dot);
+  const auto At = linearize_forward_dynamics(t, dd, q, eta, tau);
+  const auto Ac = linearize_forward_dynamics(ch, dd, q, eta, tau);
+  CHECK(rel(At.A, Ac.A) < 1e-10);
+  CHECK(rel(At.B, Ac.B) < 1e-10);
+  // a branching tree under a differential drive: the dual Jacobian equals central differences
+  std::vector<body<double>> B = {t[0], t[1], t[2]};
+  const tree<double> arms = nhdyn_ref::random_tree(rng, 5);
+  for (int i = 0; i < arms.dof(); ++i) {
+    body<double> b = arms[i];
+    b.parent = b.parent < 0 ? 2 : b.parent + 3;
+    B.push_back(b);
+  }
+  const tree<double> mm(B, Eigen::Vector3d(0, 0, -9.81), "base with branches");
+  const differential_drive<double> c(mm.dof(), 0, 1, 2);
+  const int n = mm.dof(), m = c.m();
+  VectorXd z(n + 2 * m);
+  z << random_state(rng, n), random_state(rng, m), random_state(rng, m);
+  const auto id = inverse_dynamics(mm, c);
+  const auto f = [&](const auto& x) { return id(x.head(n), x.segment(n, m), x.tail(m)).eval(); };
+  const MatrixXd Jfd = central_difference_jacobian(f, z, 1e-6);
+  const inverse_dynamics_linearizer lin(mm, c);
+  CHECK(rel(lin(z.head(n), z.segment(n, m), z.tail(m)).J, Jfd) < 1e-7);
+}
+
+TEST_CASE("interval bounds run on trees: they enclose the point values and equal the chain's on paper5", "[tree][bounds]") {
+  std::mt19937_64 rng(53);
+  const chain<double> ch = presets::paper5_chain().dynamic_size();
+  const differential_drive<double> dd(5, 0, 1, 2, 0.0, -1.0);
+  const tree<double> t = as_tree(ch);
+  const VectorXd q = random_state(rng, 5), eta = random_state(rng, 4), eta_dot = random_state(rng, 4);
+  const auto around = [](const VectorXd& x, double r) {
+    box<dynamic> b(x.size());
+    for (Eigen::Index i = 0; i < x.size(); ++i) b(i) = interval(x(i) - r, x(i) + r);
+    return b;
+  };
+  const auto bt = torque_bounds(t, dd, around(q, 0.01), around(eta, 0.01), around(eta_dot, 0.01));
+  const auto bc = torque_bounds(ch, dd, around(q, 0.01), around(eta, 0.01), around(eta_dot, 0.01));
+  const VectorXd tau = inverse_dynamics(t, dd)(q, eta, eta_dot);
+  for (int i = 0; i < 4; ++i) {
+    CHECK(bt(i).lower() <= tau(i));
+    CHECK(bt(i).upper() >= tau(i));
+    // another kernel, another order of operations: another (valid) enclosure, of like width
+    INFO("width tree " << bt(i).upper() - bt(i).lower() << ", chain " << bc(i).upper() - bc(i).lower());
+    CHECK(bt(i).upper() - bt(i).lower() < 10 * (bc(i).upper() - bc(i).lower()));
+  }
+  // every τ at points of the box, computed by the chain kernel, lies in the tree's enclosure
+  const auto id_chain = inverse_dynamics(ch, dd);
+  for (int k = 0; k < 50; ++k) {
+    const VectorXd tk = id_chain(q + 0.01 * random_state(rng, 5, 1.0), eta + 0.01 * random_state(rng, 4, 1.0),
+                                 eta_dot + 0.01 * random_state(rng, 4, 1.0));
+    for (int i = 0; i < 4; ++i) CHECK((bt(i).lower() <= tk(i) && tk(i) <= bt(i).upper()));
+  }
+  const tree<double> b = nhdyn_ref::random_tree(rng, 7);
+  const VectorXd x = random_state(rng, 7), xd = random_state(rng, 7), xdd = random_state(rng, 7);
+  const auto h = torque_bounds(b, around(x, 1e-3), around(xd, 1e-3), around(xdd, 1e-3));
+  const VectorXd v = rne(b)(x, xd, xdd);
+  for (int i = 0; i < 7; ++i) {
+    CHECK(h(i).lower() <= v(i));
+    CHECK(h(i).upper() >= v(i));
+  }
 }

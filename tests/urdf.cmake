@@ -16,3 +16,8 @@ if(TARGET test_urdf)
     set_tests_properties(test_urdf PROPERTIES DISABLED TRUE)
   endif()
 endif()
+# docs/api.md's URDF snippet
+if(TARGET test_docs_examples AND TARGET nhdyn::urdf)
+  target_link_libraries(test_docs_examples PRIVATE nhdyn::urdf)
+  target_compile_definitions(test_docs_examples PRIVATE NHDYN_HAVE_URDF=1)
+endif()

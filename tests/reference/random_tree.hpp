@@ -57,7 +57,8 @@ inline nhdyn::tree<double> random_tree(std::mt19937_64& rng, int n, double branc
     b.inertia = random_inertia(rng, b.mass);
   }
   if (n > 2) {
-    B[1].mass = 0;  // massless, with rotational inertia
+    B[1].mass = 0;  // massless, with rotational inertia; it turns (a massless body sliding
+    B[1].joint = nhdyn::joint_type::revolute;  // at a leaf would make M singular)
     B[std::size_t(n - 1)].inertia.setZero();  // a point mass
   }
   const Eigen::Vector3d g = random_vector(rng, 1).normalized() * 9.81;

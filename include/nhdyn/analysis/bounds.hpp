@@ -26,7 +26,7 @@
 #include "../constraints/forward_dynamics.hpp"
 #include "../constraints/stages.hpp"
 #include "../dynamics/rne.hpp"
-#include "../model/presets.hpp"
+#include "../robots/presets.hpp"
 #include "../scalar/interval.hpp"
 
 namespace nhdyn {
@@ -108,9 +108,12 @@ auto bounded(const F& f, const char* what) {
 }  // namespace detail
 
 /// Enclosure of the nonholonomic τ = project∘rne∘lift over q ∈ Q, η ∈ H, η̇ ∈ HD.
-/// The chain may be double (a fixed model) or interval (a model with uncertain parameters).
-template <class S, int N, class C, int M>
-vecN<interval, M> torque_bounds(const chain<S, N>& ch, const C& c, const box<N>& Q, const box<M>& H,
+/// The model — a chain<S, N>, or a tree<S> with run-time-sized boxes — may be double (a fixed
+/// model) or interval (a model with uncertain parameters).
+template <int N, class Model, class C, int M>
+  requires(std::is_same_v<Model, chain<typename Model::scalar_type, N>> ||
+           std::is_same_v<Model, tree<typename Model::scalar_type>>)
+vecN<interval, M> torque_bounds(const Model& ch, const C& c, const box<N>& Q, const box<M>& H,
                                 const box<M>& HD, int split = 0, rne_options o = {}) {
   const int n = c.dof(), m = c.m();
   detail::check_size(Q, n, "q");
@@ -127,9 +130,12 @@ vecN<interval, M> torque_bounds(const chain<S, N>& ch, const C& c, const box<N>&
   return detail::bounded([&] { return enclose(f, detail::stack<interval, Z>(Q, H, HD), split); }, "tau");
 }
 
-/// Enclosure of the holonomic v = rne(q, q̇, q̈) over q ∈ Q, q̇ ∈ QD, q̈ ∈ QDD.
-template <class S, int N>
-vecN<interval, N> torque_bounds(const chain<S, N>& ch, const box<N>& Q, const box<N>& QD, const box<N>& QDD,
+/// Enclosure of the holonomic v = rne(q, q̇, q̈) over q ∈ Q, q̇ ∈ QD, q̈ ∈ QDD (a chain, or a
+/// tree with run-time-sized boxes).
+template <int N, class Model>
+  requires(std::is_same_v<Model, chain<typename Model::scalar_type, N>> ||
+           std::is_same_v<Model, tree<typename Model::scalar_type>>)
+vecN<interval, N> torque_bounds(const Model& ch, const box<N>& Q, const box<N>& QD, const box<N>& QDD,
                                 int split = 0, rne_options o = {}) {
   const int n = ch.dof();
   detail::check_size(Q, n, "q");
@@ -144,9 +150,12 @@ vecN<interval, N> torque_bounds(const chain<S, N>& ch, const box<N>& Q, const bo
   return detail::bounded([&] { return enclose(f, detail::stack<interval, Z>(Q, QD, QDD), split); }, "tau");
 }
 
-/// Enclosure of η̇ = M_η⁻¹(SᵀEτ − h_η) over q ∈ Q, η ∈ H, τ ∈ TAU.
-template <class S, int N, class C, int M>
-vecN<interval, M> eta_dot_bounds(const chain<S, N>& ch, const C& c, const box<N>& Q, const box<M>& H,
+/// Enclosure of η̇ = M_η⁻¹(SᵀEτ − h_η) over q ∈ Q, η ∈ H, τ ∈ TAU (a chain, or a tree with
+/// run-time-sized boxes).
+template <int N, class Model, class C, int M>
+  requires(std::is_same_v<Model, chain<typename Model::scalar_type, N>> ||
+           std::is_same_v<Model, tree<typename Model::scalar_type>>)
+vecN<interval, M> eta_dot_bounds(const Model& ch, const C& c, const box<N>& Q, const box<M>& H,
                                  const box<M>& TAU, int split = 0, rne_options o = {}) {
   const int n = c.dof(), m = c.m();
   detail::check_size(Q, n, "q");

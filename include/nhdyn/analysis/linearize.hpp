@@ -204,15 +204,23 @@ bool heading_turn_is_symmetry(const chain<S, N>& ch, const C& c, const rne_optio
 /// of 13. The skipped columns vanish in the full computation (x, y exactly; the heading to
 /// rounding, 1e-18 of 10), the seeded ones are the same numbers as with every column seeded,
 /// and the η̇ block agrees with it to rounding (tests/test_linearize.cpp checks all three).
-template <class S, int N, class C>
+///
+/// Model: a chain<S, N>, or a tree<S> (N = dynamic). On a tree every column of (q, η) is
+/// seeded (the structural zeros above are derived for chains only).
+template <class S, int N, class C, class Model = chain<S, N>>
 class inverse_dynamics_linearizer {
  public:
-  inverse_dynamics_linearizer(const chain<S, N>& ch, const C& c, rne_options o = {})
+  inverse_dynamics_linearizer(const Model& ch, const C& c, rne_options o = {})
       : id_(inverse_dynamics(ch, c, o)), M_(ch), c_(c), n_(c.dof()), m_(c.m()) {
     bool before_revolute = true;
-    const bool heading_symmetry = detail::heading_turn_is_symmetry(ch, c, o);
+    bool heading_symmetry = false;
+    if constexpr (std::is_same_v<Model, chain<S, N>>) heading_symmetry = detail::heading_turn_is_symmetry(ch, c, o);
     for (int j = 0; j < n_ + m_; ++j) {
-      if (j < n_) before_revolute = before_revolute && ch[j].joint == joint_type::prismatic;
+      if constexpr (std::is_same_v<Model, chain<S, N>>) {
+        if (j < n_) before_revolute = before_revolute && ch[j].joint == joint_type::prismatic;
+      } else {
+        before_revolute = false;
+      }
       bool zero = j < n_ && before_revolute && !constraint_depends_on(c, j);
       if constexpr (detail::is_differential_drive<C>) zero = zero || (heading_symmetry && j == c.heading);
       if (!zero) cols_.push_back(j);
@@ -269,12 +277,17 @@ class inverse_dynamics_linearizer {
   }
 
  private:
-  decltype(inverse_dynamics(std::declval<const chain<S, N>&>(), std::declval<const C&>())) id_;
-  mass_matrix_fn<S, N> M_;
+  decltype(inverse_dynamics(std::declval<const Model&>(), std::declval<const C&>())) id_;
+  decltype(mass_matrix(std::declval<const Model&>())) M_;
   C c_;
   int n_, m_;
   std::vector<int> cols_;
 };
+template <class S, int N, class C>
+inverse_dynamics_linearizer(const chain<S, N>&, const C&, rne_options = {}) -> inverse_dynamics_linearizer<S, N, C>;
+template <class S, class C>
+inverse_dynamics_linearizer(const tree<S>&, const C&, rne_options = {})
+    -> inverse_dynamics_linearizer<S, dynamic, C, tree<S>>;
 
 /// ∂τ/∂(q, η, η̇) at (q, η, η̇), by duals through project∘rne∘lift (builds the pipeline for
 /// this one call; keep an inverse_dynamics_linearizer to evaluate many states).
@@ -283,6 +296,13 @@ auto linearize_inverse_dynamics(const chain<S, N>& ch, const C& c, const Eigen::
                                 const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
                                 rne_options o = {}) {
   return inverse_dynamics_linearizer<S, N, C>(ch, c, o)(q, eta, eta_dot);
+}
+/// The same on a tree.
+template <class S, class C, class Q, class E, class ED>
+auto linearize_inverse_dynamics(const tree<S>& t, const C& c, const Eigen::MatrixBase<Q>& q,
+                                const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
+                                rne_options o = {}) {
+  return inverse_dynamics_linearizer(t, c, o)(q, eta, eta_dot);
 }
 
 /// ẋ = f(x, u) linearised: A = ∂f/∂x, B = ∂f/∂u.
@@ -303,10 +323,11 @@ struct state_space {
 /// Pinocchio's ABA derivatives come from the RNEA ones. The kinematic rows: ∂(Sη)/∂η = S,
 /// ∂(Sη)/∂q by duals of the S-product alone, ∂(Sη)/∂τ = 0. The forward dynamics' own
 /// checks apply (a non-positive-definite or ill-conditioned M_η is a numerical_error).
-template <class S, int N, class C>
+/// Model: a chain<S, N> or a tree<S> (N = dynamic).
+template <class S, int N, class C, class Model = chain<S, N>>
 class forward_dynamics_linearizer {
  public:
-  forward_dynamics_linearizer(const chain<S, N>& ch, const C& c, rne_options o = {})
+  forward_dynamics_linearizer(const Model& ch, const C& c, rne_options o = {})
       : fd_(nh_forward_dynamics(ch, c, o)), id_(ch, c, o), c_(c) {}
 
   template <class Q, class E, class TAU>
@@ -340,10 +361,15 @@ class forward_dynamics_linearizer {
   }
 
  private:
-  nh_forward_dynamics_fn<S, N, C> fd_;
-  inverse_dynamics_linearizer<S, N, C> id_;
+  nh_forward_dynamics_fn<S, N, C, Model> fd_;
+  inverse_dynamics_linearizer<S, N, C, Model> id_;
   C c_;
 };
+template <class S, int N, class C>
+forward_dynamics_linearizer(const chain<S, N>&, const C&, rne_options = {}) -> forward_dynamics_linearizer<S, N, C>;
+template <class S, class C>
+forward_dynamics_linearizer(const tree<S>&, const C&, rne_options = {})
+    -> forward_dynamics_linearizer<S, dynamic, C, tree<S>>;
 
 /// The same for one (q, η, τ) (builds the linearizer for this one call; keep a
 /// forward_dynamics_linearizer to evaluate many states).
@@ -352,6 +378,13 @@ auto linearize_forward_dynamics(const chain<S, N>& ch, const C& c, const Eigen::
                                 const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                                 rne_options o = {}) {
   return forward_dynamics_linearizer<S, N, C>(ch, c, o)(q, eta, tau);
+}
+/// The same on a tree.
+template <class S, class C, class Q, class E, class TAU>
+auto linearize_forward_dynamics(const tree<S>& t, const C& c, const Eigen::MatrixBase<Q>& q,
+                                const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
+                                rne_options o = {}) {
+  return forward_dynamics_linearizer(t, c, o)(q, eta, tau);
 }
 
 /// x = (q, q̇), f = (q̇, q̈), u = τ for a holonomic chain.

@@ -14,16 +14,21 @@ namespace nhdyn {
 
 enum class reduced_inertia_method { crba, rne_columns };
 
-template <class S, int N, class C>
+/// Model: a chain<S, N> or a tree<S> (N = dynamic): whatever rne(model) and
+/// mass_matrix(model) take.
+template <class S, int N, pfaffian_constraint C, class Model = chain<S, N>>
 class nh_forward_dynamics_fn : public stage_tag {
+  using rne_type = decltype(rne(std::declval<const Model&>(), rne_options{}));
+  using mass_matrix_type = decltype(mass_matrix(std::declval<const Model&>()));
+
  public:
   static constexpr int M = C::m_at_compile_time;
 
-  nh_forward_dynamics_fn(const chain<S, N>& ch, C c, rne_options o = {},
+  nh_forward_dynamics_fn(const Model& ch, C c, rne_options o = {},
                          reduced_inertia_method method = reduced_inertia_method::crba)
       : c_(std::move(c)), rne_(ch, o), inertia_rne_(ch, {false, false}), M_(ch), method_(method) {
     if (c_.dof() != ch.dof())
-      throw model_error("constraint is over " + std::to_string(c_.dof()) + " joints, the chain has " +
+      throw model_error("constraint is over " + std::to_string(c_.dof()) + (std::is_same_v<Model, tree<S>> ? " joints, the tree has " : " joints, the chain has ") +
                         std::to_string(ch.dof()));
   }
   const C& constraint() const { return c_; }
@@ -82,7 +87,7 @@ class nh_forward_dynamics_fn : public stage_tag {
     detail::check_finite(tau, "tau");
     const vecN<T, M> h = reduced_bias(q, eta);
     vecN<T, M> u;
-    constexpr bool has_E = requires { c_.E(q); };
+    constexpr bool has_E = has_input_map<C, Q>;
     if constexpr (has_E) {
       u = (c_.S(q).transpose() * c_.E(q)).template cast<T>() * tau.template cast<T>();
     } else if constexpr (C::orthonormal_S) {
@@ -111,16 +116,23 @@ class nh_forward_dynamics_fn : public stage_tag {
 
  private:
   C c_;
-  rne_fn<S, N> rne_;
-  rne_fn<S, N> inertia_rne_;
-  mass_matrix_fn<S, N> M_;
+  rne_type rne_;
+  rne_type inertia_rne_;
+  mass_matrix_type M_;
   reduced_inertia_method method_;
 };
 
-template <class S, int N, class C>
+template <class S, int N, pfaffian_constraint C>
 auto nh_forward_dynamics(const chain<S, N>& ch, const C& c, rne_options o = {},
                          reduced_inertia_method method = reduced_inertia_method::crba) {
   return nh_forward_dynamics_fn<S, N, C>(ch, c, o, method);
+}
+
+/// The constrained forward dynamics of a tree (the constraint over its joints in q order).
+template <class S, pfaffian_constraint C>
+auto nh_forward_dynamics(const tree<S>& t, const C& c, rne_options o = {},
+                         reduced_inertia_method method = reduced_inertia_method::crba) {
+  return nh_forward_dynamics_fn<S, dynamic, C, tree<S>>(t, c, o, method);
 }
 
 }  // namespace nhdyn

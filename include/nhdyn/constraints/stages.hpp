@@ -16,6 +16,7 @@
 /// and the constraint forces λ = (A Aᵀ)⁻¹ A (v − E τ), which do no work (q̇ᵀAᵀλ = 0).
 #include "../detail/ldlt.hpp"
 #include "../dynamics/rne.hpp"
+#include "../dynamics/tree.hpp"
 #include "constraint.hpp"
 #include <Eigen/LU>
 
@@ -101,7 +102,7 @@ class lift_fn : public stage_tag {
   C c_;
 };
 
-template <class C>
+template <pfaffian_constraint C>
 lift_fn<C> lift(C c) {
   return lift_fn<C>(std::move(c));
 }
@@ -114,7 +115,7 @@ auto solve_StE(const C& c, const Eigen::MatrixBase<Q>& q, R r) {
   using T = typename R::Scalar;
   constexpr int M = C::m_at_compile_time;
   using P = Eigen::Matrix<T, M, R::ColsAtCompileTime>;  // vecN<T, M> for a vector r
-  constexpr bool has_E = requires { c.E(q); };
+  constexpr bool has_E = has_input_map<C, Q>;
   if constexpr (C::orthonormal_S && !has_E && std::is_same_v<R, P>) {
     return r;
   } else if constexpr (C::orthonormal_S && !has_E) {
@@ -173,7 +174,7 @@ class project_fn : public stage_tag {
   auto operator()(with_memo<generalized_forces<X, N>, Memo>&& f) const {
     if constexpr (requires { c_.St_times_in_place(f.q, std::move(f.v), f.memo); }) {
       detail::check_size(f.v, c_.dof(), "v");
-      if constexpr (C::orthonormal_S && !requires { c_.E(f.q); })
+      if constexpr (C::orthonormal_S && !has_input_map<C, decltype(f.q)>)
         return c_.St_times_in_place(f.q, std::move(f.v), f.memo);  // SᵀS = I: Sᵀv is τ (no copy)
       else
         return detail::solve_StE(c_, f.q, c_.St_times_in_place(f.q, std::move(f.v), f.memo));
@@ -186,7 +187,7 @@ class project_fn : public stage_tag {
   C c_;
 };
 
-template <class C>
+template <pfaffian_constraint C>
 project_fn<C> project(C c) {
   return project_fn<C>(std::move(c));
 }
@@ -203,7 +204,7 @@ class constraint_forces_fn : public stage_tag {
     using T = typename decltype(tau)::Scalar;
     constexpr int M = C::m_at_compile_time, K = C::k_at_compile_time;
     constrained_forces<T, M, K> out;
-    if constexpr (!requires { c_.E(q); } && requires { c_.A_times(q, v); }) {
+    if constexpr (!has_input_map<C, Q> && requires { c_.A_times(q, v); }) {
       // E = S: A E τ = A S τ = 0, so λ = (AAᵀ)⁻¹ A v, and a constraint with orthonormal rows
       // (AAᵀ = I: differential_drive) gives it as a structured product, no matrix formed.
       out.lambda = c_.A_times(q, v);
@@ -228,7 +229,7 @@ class constraint_forces_fn : public stage_tag {
   project_fn<C> p_;
 };
 
-template <class C>
+template <pfaffian_constraint C>
 constraint_forces_fn<C> constraint_forces(C c) {
   return constraint_forces_fn<C>(std::move(c));
 }
@@ -277,7 +278,7 @@ constexpr bool fusable_inverse_dynamics() {
     // Compile-time sized, only for a floating-point state: for double it removes the stage
     // values' copies (store-forwarding stalls), but duals and intervals ran 25–35 % slower on
     // the scratch maps than through the composition (bench_scalar, 2026-11-24).
-    return std::is_same_v<promote_t<S, T>, T> && C::orthonormal_S && !requires(const C& c, const Q& q) { c.E(q); } &&
+    return std::is_same_v<promote_t<S, T>, T> && C::orthonormal_S && !has_input_map<C, Q> &&
            (C::n_at_compile_time == dynamic || std::is_floating_point_v<T>) &&
            requires(const C& c, const Q& q, const E& e, const ED& ed, Mp& m) { c.St_times(m, c.lift_into(q, e, ed, m, m)); };
   }
@@ -402,7 +403,7 @@ struct scratch_inverse_dynamics : Composed {
 };
 }  // namespace detail
 
-template <class S, int N, class C>
+template <class S, int N, pfaffian_constraint C>
 auto inverse_dynamics(const chain<S, N>& ch, const C& c, rne_options o = {}) {
   auto id = detail::nh_pipeline(ch, c, o, project(c));
   if constexpr (N == C::n_at_compile_time)
@@ -412,9 +413,35 @@ auto inverse_dynamics(const chain<S, N>& ch, const C& c, rne_options o = {}) {
 }
 
 /// As inverse_dynamics, returning (τ, λ).
-template <class S, int N, class C>
+template <class S, int N, pfaffian_constraint C>
 auto inverse_dynamics_with_forces(const chain<S, N>& ch, const C& c, rne_options o = {}) {
   return detail::nh_pipeline(ch, c, o, constraint_forces(c));
+}
+
+namespace detail {
+/// out ∘ rne ∘ lift on a tree (run-time sized; a compile-time-sized constraint's ξ resized).
+template <class S, class C, class Out>
+auto nh_tree_pipeline(const tree<S>& t, const C& c, rne_options o, Out out) {
+  if (c.dof() != t.dof())
+    throw model_error("model '" + t.name() + "': the constraint is over " + std::to_string(c.dof()) +
+                      " joints, the tree has " + std::to_string(t.dof()));
+  if constexpr (C::n_at_compile_time == dynamic)
+    return compose(std::move(out), rne(t, o), lift(c));
+  else
+    return compose(std::move(out), rne(t, o), resize_fn<dynamic>{}, lift(c));
+}
+}  // namespace detail
+
+/// The nonholonomic inverse dynamics of a tree: project ∘ rne ∘ lift, the constraint over the
+/// tree's joints in q order.
+template <class S, pfaffian_constraint C>
+auto inverse_dynamics(const tree<S>& t, const C& c, rne_options o = {}) {
+  return detail::nh_tree_pipeline(t, c, o, project(c));
+}
+/// As inverse_dynamics on a tree, returning (τ, λ).
+template <class S, pfaffian_constraint C>
+auto inverse_dynamics_with_forces(const tree<S>& t, const C& c, rne_options o = {}) {
+  return detail::nh_tree_pipeline(t, c, o, constraint_forces(c));
 }
 
 }  // namespace nhdyn

@@ -14,7 +14,7 @@
 /// Example:
 ///     auto id = nhdyn::rne(nhdyn::presets::puma560());
 ///     Eigen::VectorXd tau = id(q, qd, qdd);
-#include "../detail/dh.hpp"
+#include "../model/dh_kernel.hpp"
 #include "../detail/small_buffer.hpp"
 #include "../functional/compose.hpp"
 #include "../functional/values.hpp"
@@ -84,7 +84,7 @@ void rne_kernel(const Links& L, const vec3<T>& g, const Q& q, const QD& qd, cons
   v3<T> acc = Gravity ? v3<T>{-g.x(), -g.y(), -g.z()} : v3<T>{zero, zero, zero};  // a_{o_i} − g
   // Forward pass: velocities and accelerations, base to tip. Model constants (cos α, sin α,
   // m, m c, I_o, and p for a revolute joint) stay in the model's scalar: mixed products
-  // (detail/dh.hpp) are cheaper for duals and intervals, and the same for double.
+  // (model/dh_kernel.hpp) are cheaper for duals and intervals, and the same for double.
   //
   // Links before the first revolute joint (a mobile base's x and y, say) only translate:
   // ω = ω̇ = 0 there, so a_i = R_iᵀ a_{i−1} + z q̈_i and every cross product vanishes. They

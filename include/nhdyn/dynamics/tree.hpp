@@ -195,6 +195,13 @@ class tree_rne_fn : public stage_tag {
   generalized_forces<promote_t<S, X>, dynamic> operator()(const joint_state<X, dynamic>& xi) const {
     return {xi.q.template cast<promote_t<S, X>>(), (*this)(xi.q, xi.qd, xi.qdd)};
   }
+  /// …and with a memo (what the lift computed for the projection), passed on with (q, v).
+  template <class X, class Memo>
+  auto operator()(const with_memo<joint_state<X, dynamic>, Memo>& xi) const {
+    with_memo<generalized_forces<promote_t<S, X>, dynamic>, Memo> out{
+        {xi.q.template cast<promote_t<S, X>>(), (*this)(xi.q, xi.qd, xi.qdd)}, xi.memo};
+    return out;
+  }
 
   const std::vector<detail::tree_link<S>>& links() const { return links_; }
 

@@ -34,7 +34,7 @@
 #include "../constraints/constraint.hpp"
 #include "../errors.hpp"
 #include "../model/chain.hpp"
-#include "../model/presets.hpp"
+#include "../robots/presets.hpp"
 #include "number.hpp"
 
 namespace nhdyn::io {

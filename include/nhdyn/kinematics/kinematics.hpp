@@ -13,7 +13,7 @@
 #include <range/v3/view/iota.hpp>
 #include <range/v3/view/transform.hpp>
 
-#include "../detail/dh.hpp"
+#include "../model/dh_kernel.hpp"
 #include "../detail/small_buffer.hpp"
 
 namespace nhdyn {

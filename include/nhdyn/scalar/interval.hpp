@@ -20,7 +20,7 @@
 /// one ulp beyond x, with or without a fused multiply–add), `boost_interval` by stepping
 /// one ulp through the bit pattern. sin and cos of `nhdyn::interval`: on a piece where both
 /// are monotonic (|x| ≤ 1e5, the piece decided with a 1e-9 safety margin), the endpoint
-/// values of detail/dh.hpp's kernel (fdlibm's polynomials, error < 1 ulp ≤ 2.3e-16) widened
+/// values of scalar/sincos.hpp's kernel (fdlibm's polynomials, error < 1 ulp ≤ 2.3e-16) widened
 /// by 4.5e-16 and then outward, clamped to [−1, 1]; otherwise Boost's. Library functions of
 /// `boost_interval` use the C library (glibc: ≤ 1 ulp) and move 2 ulps outward.
 ///
@@ -41,7 +41,7 @@
 #include <boost/numeric/interval.hpp>
 #include <utility>
 
-#include "../detail/sincos.hpp"
+#include "sincos.hpp"
 #include <cmath>
 #include <cstdint>
 #include <limits>

@@ -26,7 +26,7 @@
 
 #include "../constraints/forward_dynamics.hpp"
 #include "../io/number.hpp"
-#include "../model/presets.hpp"
+#include "../robots/presets.hpp"
 #include "controller.hpp"
 #include "integrators.hpp"
 

@@ -1,5 +1,5 @@
 #pragma once
-/// \file detail/dh.hpp
+/// \file model/dh_kernel.hpp
 /// Link-frame building blocks shared by kinematics and dynamics: per-link constants
 /// precomputed once per model, and the elementary rotations of a standard DH row.
 ///
@@ -12,9 +12,9 @@
 #include <type_traits>
 #include <vector>
 
-#include "../model/chain.hpp"
-#include "sincos.hpp"
-#include "small_buffer.hpp"
+#include "chain.hpp"
+#include "../scalar/sincos.hpp"
+#include "../detail/small_buffer.hpp"
 
 namespace nhdyn::detail {
 

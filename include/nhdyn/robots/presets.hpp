@@ -1,5 +1,5 @@
 #pragma once
-/// \file model/presets.hpp
+/// \file robots/presets.hpp
 /// Ready-made robots.
 ///
 /// - `paper5`: the paper's 5-DOF mobile manipulator, exactly as ../shared/spec/paper5.md
@@ -18,7 +18,7 @@
 #include <type_traits>
 
 #include "../constraints/constraint.hpp"
-#include "chain.hpp"
+#include "../model/chain.hpp"
 #include "robot.hpp"
 
 namespace nhdyn::presets {

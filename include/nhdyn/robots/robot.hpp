@@ -1,8 +1,8 @@
 #pragma once
-/// \file model/robot.hpp
+/// \file robots/robot.hpp
 /// A robot: a chain and the constraint on its joints (holonomic<N> for none).
 #include "../constraints/constraint.hpp"
-#include "chain.hpp"
+#include "../model/chain.hpp"
 
 namespace nhdyn {
 

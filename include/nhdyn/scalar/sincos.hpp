@@ -1,5 +1,5 @@
 #pragma once
-/// \file detail/sincos.hpp
+/// \file scalar/sincos.hpp
 /// sin and cos of doubles without a library call (used by the kernels and by
 /// nhdyn::interval).
 #include <cmath>

@@ -1,0 +1,125 @@
+#pragma once
+/// \file constraints/concept.hpp
+/// Pfaffian (velocity) constraints A(q) q̇ = 0 on a chain of n joints, with a basis S(q) of
+/// the admissible velocities (A S = 0), its derivative Ṡ(q, q̇) and the actuator input map
+/// E(q) (default S):
+///
+///     q̇ = S(q) η,   q̈ = S(q) η̇ + Ṡ(q, q̇) η,   v = E(q) τ + A(q)ᵀ λ        (paper eq. 1–2)
+///
+/// A constraint type provides `dof()` (n), `k()`, `m()` and, templated on the scalar,
+/// `A(q)` (k×n), `S(q)` (n×m), `Sdot(q, qd)` (n×m). Optionally `E(q)` (n×m), and the
+/// structured products `S_times(q, η)`, `St_times(q, v)`, `Sdot_times(q, q̇, η)` and
+/// `St_M_S(q, M)` (the reduced inertia SᵀMS of a symmetric M) that avoid forming matrices;
+/// the free functions below fall back to the dense forms.
+///
+/// Built in: `holonomic` (S = I, k = 0), `differential_drive` (any x, y, heading triple of
+/// joints, forward axis a parameter), `user_constraint` (plain functions of q; Ṡ by duals
+/// when not given).
+///
+/// This header: the `pfaffian_constraint` concept, its optional parts, and uniform access.
+/// One header per built-in constraint type: holonomic.hpp, differential_drive.hpp,
+/// user_constraint.hpp; constraint.hpp includes them all.
+#include <concepts>
+#include "../model/chain.hpp"
+
+namespace nhdyn {
+
+template <class S, int R, int C>
+using matrix = Eigen::Matrix<S, R, C>;
+
+
+/// What every constraint type provides (docs/api.md §6): its sizes at compile time (or
+/// `dynamic`) and at run time, and, on any scalar, A(q) (k×n), S(q) (n×m) and Ṡ(q, q̇) (n×m).
+/// Everything else is optional and has a named concept below; the stages take any
+/// `pfaffian_constraint`, and the free functions use the optional parts where present.
+template <class C>
+concept pfaffian_constraint = requires(const C& c, const vecN<double, C::n_at_compile_time>& q) {
+  { C::n_at_compile_time } -> std::convertible_to<int>;
+  { C::k_at_compile_time } -> std::convertible_to<int>;
+  { C::m_at_compile_time } -> std::convertible_to<int>;
+  { c.dof() } -> std::convertible_to<int>;
+  { c.k() } -> std::convertible_to<int>;
+  { c.m() } -> std::convertible_to<int>;
+  c.A(q);
+  c.S(q);
+  c.Sdot(q, q);
+};
+
+/// Optional: an input map E(q) (n×m) other than S (v = E τ + Aᵀ λ).
+template <class C, class Q>
+concept has_input_map = requires(const C& c, const Q& q) { c.E(q); };
+/// Optional: q̇ = S η without forming S.
+template <class C, class Q, class E>
+concept has_S_times = requires(const C& c, const Q& q, const E& eta) { c.S_times(q, eta); };
+/// Optional: Sᵀ v without forming S.
+template <class C, class Q, class V>
+concept has_St_times = requires(const C& c, const Q& q, const V& v) { c.St_times(q, v); };
+/// Optional: Ṡ η without forming Ṡ.
+template <class C, class Q, class QD, class E>
+concept has_Sdot_times = requires(const C& c, const Q& q, const QD& qd, const E& eta) { c.Sdot_times(q, qd, eta); };
+/// Optional: the reduced inertia Sᵀ M S of a symmetric M, structured.
+template <class C, class Q, class MM>
+concept has_St_M_S = requires(const C& c, const Q& q, const MM& M) { c.St_M_S(q, M); };
+/// Optional: which joints A, S, Ṡ, E depend on (else: all).
+template <class C>
+concept has_depends_on = requires(const C& c, int j) { c.depends_on(j); };
+
+// ---- uniform access: structured products where the constraint has them, dense otherwise.
+
+/// Whether A, S, Ṡ or E may depend on q_j: a constraint's `depends_on(j)` where it has one,
+/// else true.
+template <class C>
+bool constraint_depends_on(const C& c, int j) {
+  if constexpr (has_depends_on<C>)
+    return c.depends_on(j);
+  else
+    return true;
+}
+
+namespace detail {
+/// Sᵀ M S in the scalar T for a symmetric M: the constraint's structured `St_M_S` when it has
+/// one (differential_drive: O(n²)), else dense products (O(n²m)).
+template <class T, class C, class Q, class MM>
+matrix<T, C::m_at_compile_time, C::m_at_compile_time> project_inertia(const C& c, const Eigen::MatrixBase<Q>& q,
+                                                                      const Eigen::MatrixBase<MM>& M) {
+  if constexpr (has_St_M_S<C, Q, MM>) {
+    return c.St_M_S(q, M).template cast<T>();
+  } else {
+    const auto S = c.S(q);
+    return (S.transpose().template cast<T>() * M.template cast<T>() * S.template cast<T>());
+  }
+}
+}  // namespace detail
+
+template <class C, class Q>
+auto input_map(const C& c, const Eigen::MatrixBase<Q>& q) {
+  if constexpr (has_input_map<C, Q>)
+    return c.E(q);
+  else
+    return c.S(q);
+}
+template <class C, class Q, class E>
+auto apply_S(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta) {
+  if constexpr (has_S_times<C, Q, E>)
+    return c.S_times(q, eta);
+  else
+    return vecN<promote_t<typename Q::Scalar, typename E::Scalar>, C::n_at_compile_time>(c.S(q) * eta);
+}
+template <class C, class Q, class V>
+auto apply_St(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) {
+  if constexpr (has_St_times<C, Q, V>)
+    return c.St_times(q, v);
+  else
+    return vecN<promote_t<typename Q::Scalar, typename V::Scalar>, C::m_at_compile_time>(c.S(q).transpose() * v);
+}
+template <class C, class Q, class QD, class E>
+auto apply_Sdot(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
+                const Eigen::MatrixBase<E>& eta) {
+  if constexpr (has_Sdot_times<C, Q, QD, E>)
+    return c.Sdot_times(q, qd, eta);
+  else
+    return vecN<promote_t<promote_t<typename Q::Scalar, typename QD::Scalar>, typename E::Scalar>,
+                C::n_at_compile_time>(c.Sdot(q, qd) * eta);
+}
+
+}  // namespace nhdyn
