@@ -220,6 +220,38 @@ void register_nh(const std::string& model, const chain<double>& cd) {
           benchmark::DoNotOptimize(tau);
         });
   }
+  // nh_fused/<model>/{fixed, run_time}: a = the plain composition project ∘ rne ∘ lift,
+  // b = inverse_dynamics (which runs the call (q, η, η̇) on stack scratch with the lift inside
+  // rne): ratio < 0.85 is what the fused path must buy to exist (15 %).
+  {
+    auto pf = nhdyn::compose(nhdyn::project(conf), nhdyn::rne(cf), nhdyn::lift(conf));
+    auto pd = nhdyn::compose(nhdyn::project(cond), nhdyn::rne(cd), nhdyn::lift(cond));
+    agree(pf(qf, ef, edf), idf(qf, ef, edf), 0.0, "nh_fused/" + model + ": composition vs fused, bit for bit");
+    add_paired(
+        "nh_fused/" + model + "/fixed",
+        [pf, qf, ef, edf]() mutable {
+          opaque(qf), opaque(ef), opaque(edf);
+          auto tau = pf(qf, ef, edf);
+          benchmark::DoNotOptimize(tau);
+        },
+        [idf, qf, ef, edf]() mutable {
+          opaque(qf), opaque(ef), opaque(edf);
+          auto tau = idf(qf, ef, edf);
+          benchmark::DoNotOptimize(tau);
+        });
+    add_paired(
+        "nh_fused/" + model + "/run_time",
+        [pd, z]() mutable {
+          opaque(z.q), opaque(z.eta), opaque(z.eta_dot);
+          auto tau = pd(z.q, z.eta, z.eta_dot);
+          benchmark::DoNotOptimize(tau);
+        },
+        [idd, z]() mutable {
+          opaque(z.q), opaque(z.eta), opaque(z.eta_dot);
+          auto tau = idd(z.q, z.eta, z.eta_dot);
+          benchmark::DoNotOptimize(tau);
+        });
+  }
   add("nh_id/" + model + "/lagrange", [el, z]() mutable {
     opaque(z.q), opaque(z.eta), opaque(z.eta_dot);
     auto tau = el(z.q, z.eta, z.eta_dot);

@@ -196,7 +196,29 @@ TEST_CASE("a file in the style of real robot descriptions loads, warns per link,
 #ifdef NHDYN_HAVE_KDL
   const kdl_model kdl(text, t);
   CHECK(rel(rne(t)(q, qd, qdd), kdl.rne(q, qd, qdd, t.gravity())) < 1e-12);
+  const int n = t.dof();
+  MatrixXd Mk(n, n);
+  for (int j = 0; j < n; ++j) Mk.col(j) = kdl.rne(q, VectorXd::Zero(n), VectorXd::Unit(n, j), Eigen::Vector3d::Zero());
+  CHECK(rel(mass_matrix(t)(q), Mk) < 1e-12);
+  const VectorXd tau = rne(t)(q, qd, qdd);
+  const VectorXd bias_k = kdl.rne(q, qd, VectorXd::Zero(n), t.gravity());
+  CHECK(rel(forward_dynamics(t)(q, qd, tau), Mk.ldlt().solve(tau - bias_k)) < 1e-9);
 #endif
+}
+
+TEST_CASE("a mass matrix that a file's inertias make indefinite is named as such by forward dynamics", "[urdf][errors]") {
+  // a leaf link whose inertia about its only joint's axis is negative: loads with a warning,
+  // rne runs as given, forward dynamics refuses and says why
+  const std::string text = R"(<robot name="bad"><link name="base"/>
+    <link name="wheel"><inertial><mass value="0"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="-0.5"/></inertial></link>
+    <joint name="spin" type="continuous"><parent link="base"/><child link="wheel"/><axis xyz="0 0 1"/></joint></robot>)";
+  std::vector<std::string> warnings;
+  const tree<double> t = load(text, warnings);
+  REQUIRE(warnings.size() == 1);
+  CHECK_THAT(warnings[0], Catch::Contains("not positive semi-definite"));
+  CHECK(rne(t)(VectorXd::Zero(1), VectorXd::Zero(1), VectorXd::Ones(1))(0) == Approx(-0.5));
+  CHECK_THROWS_WITH(forward_dynamics(t)(VectorXd::Zero(1), VectorXd::Zero(1), VectorXd::Ones(1)),
+                    Catch::Contains("mass matrix M(q) is not positive definite"));
 }
 
 TEST_CASE("URDF errors name the file, the element and the problem", "[urdf][errors]") {

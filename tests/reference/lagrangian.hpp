@@ -37,13 +37,20 @@ using mat3 = Eigen::Matrix<T, 3, 3>;
 template <class T>
 using mat4 = Eigen::Matrix<T, 4, 4>;
 
-/// One DH row and its rigid body (com in frame i, inertia about the com in frame i's axes).
+/// One DH row and its rigid body (com in frame i, inertia about the com in frame i's axes);
+/// or, for a tree (`general`), a body whose frame is parent · X_PJ · joint(q) · X_JB, the joint
+/// turning about or sliding along `axis` (4×4 homogeneous matrices, Rodrigues' formula: no
+/// library code).
 template <class T>
 struct body {
   bool revolute = true;
   T alpha{0}, a{0}, theta{0}, d{0}, mass{0};
   vec3<T> com = vec3<T>::Zero();
   mat3<T> inertia = mat3<T>::Zero();
+  bool general = false;
+  int parent = -2;  // −2: the previous body (a chain); −1: the base; else a body index
+  mat4<T> X_PJ = mat4<T>::Identity(), X_JB = mat4<T>::Identity();
+  vec3<T> axis = vec3<T>(T(0), T(0), T(1));
 };
 
 /// A chain as the reference sees it.
@@ -77,17 +84,69 @@ model<T> from_chain(const nhdyn::chain<S, N>& c) {
   return m;
 }
 
+/// The data of an nhdyn tree, converted to T (no library algorithm is used).
+template <class T, class Tree>
+model<T> from_tree(const Tree& t) {
+  model<T> m;
+  const auto hom = [](const auto& R, const auto& p) {
+    mat4<T> X = mat4<T>::Identity();
+    for (int r = 0; r < 3; ++r) {
+      X(r, 3) = T(p(r));
+      for (int k = 0; k < 3; ++k) X(r, k) = T(R(r, k));
+    }
+    return X;
+  };
+  for (int i = 0; i < t.dof(); ++i) {
+    const auto& B = t[i];
+    body<T> b;
+    b.general = true;
+    b.revolute = B.joint == nhdyn::joint_type::revolute;
+    b.parent = B.parent;
+    b.X_PJ = hom(B.R_PJ, B.p_PJ);
+    b.X_JB = hom(B.R_JB, B.p_JB);
+    for (int r = 0; r < 3; ++r) {
+      b.axis(r) = T(B.axis(r));
+      b.com(r) = T(B.com(r));
+      for (int k = 0; k < 3; ++k) b.inertia(r, k) = T(B.inertia(r, k));
+    }
+    b.mass = T(B.mass);
+    m.bodies.push_back(b);
+  }
+  for (int r = 0; r < 3; ++r) m.gravity(r) = T(t.gravity()(r));
+  return m;
+}
+
 /// A value of the model scalar T as the computation scalar U (T, or duals over T).
 template <class U, class T>
 U lift(const T& x) {
   return U(x);
 }
 
-/// Homogeneous transform of link i at joint value qi: Rz(θ) Tz(d) Tx(a) Rx(α).
+/// Homogeneous transform of link i at joint value qi: Rz(θ) Tz(d) Tx(a) Rx(α); for a tree
+/// body X_PJ · joint(qi) · X_JB.
 template <class U, class T>
 mat4<U> dh_matrix(const body<T>& b, const U& qi) {
   using std::cos;
   using std::sin;
+  if (b.general) {
+    mat4<U> J = mat4<U>::Identity();
+    const vec3<U> u(lift<U>(b.axis(0)), lift<U>(b.axis(1)), lift<U>(b.axis(2)));
+    if (b.revolute) {  // Rodrigues: R = cos q 1 + sin q [u]x + (1 − cos q) u uᵀ
+      mat3<U> K;
+      K << U(0), -u(2), u(1), u(2), U(0), -u(0), -u(1), u(0), U(0);
+      const U c = cos(qi), s = sin(qi);
+      J.template block<3, 3>(0, 0) = c * mat3<U>::Identity() + s * K + (U(1) - c) * (u * u.transpose());
+    } else {
+      J.template block<3, 1>(0, 3) = u * qi;
+    }
+    const auto cast4 = [](const mat4<T>& X) {
+      mat4<U> Y;
+      for (int r = 0; r < 4; ++r)
+        for (int k = 0; k < 4; ++k) Y(r, k) = lift<U>(X(r, k));
+      return Y;
+    };
+    return cast4(b.X_PJ) * J * cast4(b.X_JB);
+  }
   const U th = b.revolute ? U(lift<U>(b.theta) + qi) : lift<U>(b.theta);
   const U d = b.revolute ? lift<U>(b.d) : U(lift<U>(b.d) + qi);
   const U ca = lift<U>(T(cos(b.alpha))), sa = lift<U>(T(sin(b.alpha)));
@@ -110,8 +169,10 @@ mat4<U> dh_matrix(const body<T>& b, const U& qi) {
 template <class U, class T>
 std::vector<mat4<U>> poses(const model<T>& m, const vec<U>& q) {
   std::vector<mat4<U>> X(std::size_t(m.dof() + 1), mat4<U>::Identity());
-  for (int i = 0; i < m.dof(); ++i)
-    X[std::size_t(i + 1)] = X[std::size_t(i)] * dh_matrix<U>(m.bodies[std::size_t(i)], q(i));
+  for (int i = 0; i < m.dof(); ++i) {
+    const int parent = m.bodies[std::size_t(i)].parent == -2 ? i - 1 : m.bodies[std::size_t(i)].parent;
+    X[std::size_t(i + 1)] = X[std::size_t(parent + 1)] * dh_matrix<U>(m.bodies[std::size_t(i)], q(i));
+  }
   return X;
 }
 
