@@ -6,6 +6,7 @@
 
 #include <nhdyn/dynamics/reference.hpp>
 #include <nhdyn/dynamics/tree.hpp>
+#include <nhdyn/io/robot_file.hpp>
 #include <nhdyn/io/urdf.hpp>
 #include <nhdyn/kinematics/tree.hpp>
 #include <nhdyn/nhdyn.hpp>
@@ -328,4 +329,72 @@ TEST_CASE("the shipped mobile manipulator: 16 joints in the documented order, ph
     CHECK(rel(tau, kdl.rne(q, qd, qdd, t.gravity())) < 1e-12);
 #endif
   }
+}
+
+TEST_CASE("robot files: a URDF on a planar base with the no-slip constraint runs the paper's method", "[urdf][robot_file]") {
+  const std::string dir = std::string(NHDYN_SOURCE_DIR) + "/examples/";
+  const io::robot_model r = io::load_robot_file(dir + "robots/mobile_manipulator.json");
+  const tree<double>& t = r.model;
+  REQUIRE(r.constraint);
+  const auto& c = *r.constraint;
+  REQUIRE(t.dof() == 19);
+  CHECK(t[0].joint_name == "base_x");
+  CHECK(t[1].joint_name == "base_y");
+  CHECK(t[2].joint_name == "base_yaw");
+  CHECK(t[3].joint_name == "wheel_left_joint");
+  CHECK(t.body_index("base_footprint") == 2);  // the root link moves now
+  CHECK(c.k() == 1);
+  CHECK(c.m() == 18);
+  // the total mass, read from the URDF by urdfdom (no merging): pushing the robot forward at
+  // rest with everything else still takes (Σ m) · a along the root link's x axis
+  const auto urdf_model = urdf::parseURDF(read(dir + "urdf/mobile_manipulator.urdf"));
+  double total = 0;
+  for (const auto& [name, link] : urdf_model->links_)
+    if (link->inertial) total += link->inertial->mass;
+  const auto id = inverse_dynamics(t, c);
+  VectorXd q = VectorXd::Zero(19), eta = VectorXd::Zero(18), eta_dot = VectorXd::Zero(18);
+  q(2) = 0.7;  // any heading
+  eta_dot(0) = 1.3;
+  CHECK(id(q, eta, eta_dot)(0) == Approx(total * 1.3).epsilon(1e-12));
+  // at random states: τ = Sᵀ(M S η̇ + h) from CRBA and the holonomic rne; FD inverts it;
+  // and the lifted velocity never slips sideways (A S η = 0)
+  std::mt19937_64 rng(61);
+  const auto fd = nh_forward_dynamics(t, c);
+  for (int s = 0; s < 3; ++s) {
+    q = random_state(rng, 19), eta = random_state(rng, 18), eta_dot = random_state(rng, 18);
+    const VectorXd tau = id(q, eta, eta_dot);
+    const MatrixXd S = c.S(q);
+    const VectorXd qd = S * eta, qdd = S * eta_dot + c.Sdot(q, qd) * eta;
+    CHECK(rel(tau, S.transpose() * (mass_matrix(t)(q) * qdd + bias(t)(q, qd))) < 1e-12);
+    CHECK(rel(fd(q, eta, tau), eta_dot) < 1e-9);
+    // the root link's origin moves along its own x axis only
+    const tree_kinematics<double> kin(t);
+    const auto X = kin.frame(q, "base_footprint");
+    const Eigen::Vector3d v = (kin.jacobian(q, 3) * qd).head<3>();
+    CHECK(std::abs(X.R.col(1).dot(v)) < 1e-12 * std::max(1.0, v.norm()));
+  }
+}
+
+TEST_CASE("robot file errors name the file and the field", "[urdf][robot_file][errors]") {
+  const std::string dir = std::string(NHDYN_SOURCE_DIR) + "/examples/robots/x.json";
+  const auto error = [&](const std::string& text) {
+    try {
+      io::parse_robot_file(text, dir);
+    } catch (const model_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  CHECK_THAT(error(R"({"name": "r"})"), Catch::Contains("field 'urdf': missing"));
+  CHECK_THAT(error(R"({"urdf": "../urdf/mobile_manipulator.urdf", "constraint": {"type": "differential_drive"}})"),
+             Catch::Contains("needs a planar base"));
+  CHECK_THAT(error(R"({"urdf": "../urdf/mobile_manipulator.urdf", "base": {"type": "holonomic"}})"),
+             Catch::Contains("unknown base type 'holonomic' (known: planar)"));
+  CHECK_THAT(error(R"({"urdf": "../urdf/mobile_manipulator.urdf", "base": {"type": "planar"}, "constraint": {"type": "omni"}})"),
+             Catch::Contains("unknown constraint type 'omni'"));
+  CHECK_THAT(error(R"({"urdf": "../urdf/mobile_manipulator.urdf", "wheels": 2})"), Catch::Contains("unknown field(s) 'wheels'"));
+  CHECK_THAT(error(R"({"urdf": "missing.urdf"})"), Catch::Contains("missing.urdf: cannot open the file"));
+  CHECK_THAT(error(R"({"urdf": "../urdf/mobile_manipulator.urdf", "gravity": [0, 0]})"), Catch::Contains("field 'gravity'"));
+  // a fixed base: the URDF's joints only
+  CHECK(io::parse_robot_file(R"({"urdf": "../urdf/mobile_manipulator.urdf"})", dir).model.dof() == 16);
 }

@@ -16,7 +16,8 @@ constexpr std::string_view usage = R"(nhdyn fd --model MODEL [--strict]
     {"q": [n], "qd": [n], "tau": [n]}        ->  {"qdd": [n]}         qdd = M(q)^-1 (tau - bias(q, qd))
   Model with a constraint (m actuator velocities):
     {"q": [n], "eta": [m], "tau": [m]}       ->  {"eta_dot": [m]}     eta_dot = M_eta^-1 (S^T E tau - h_eta)
-  A URDF model is a tree without a constraint (the first form; q in `nhdyn model` order).
+  A URDF model is a tree without a constraint (the first form; q in `nhdyn model` order); a
+  robot file with a constraint takes the second form (eta as `nhdyn model` names it).
   A singular or near-singular (reduced) mass matrix is an error line.
   --strict: a URDF inertia that is not physically valid is an error instead of a warning.
 )";
@@ -24,6 +25,15 @@ constexpr std::string_view usage = R"(nhdyn fd --model MODEL [--strict]
 int run(const std::vector<std::string>& args) {
   const auto any = start_any_model_command(args, usage);
   if (!any) return 0;  // --help
+  if (any->tree && any->tree_constraint) {  // a robot file: (q, η, τ) -> η̇
+    const auto& c = *any->tree_constraint;
+    const auto fd = nhdyn::nh_forward_dynamics(*any->tree, c);
+    return run_lines(std::cin, std::cout, [&](const line& l) {
+      l.expect_keys({"q", "eta", "tau"});
+      const Eigen::VectorXd eta_dot = fd(l.vector("q", c.dof()), l.vector("eta", c.m()), l.vector("tau", c.m()));
+      return ordered_json{{"eta_dot", to_json(eta_dot)}};
+    });
+  }
   if (any->tree) {
     const auto& t = *any->tree;
     const auto fd = nhdyn::forward_dynamics(t);

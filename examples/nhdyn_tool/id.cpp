@@ -17,7 +17,8 @@ constexpr std::string_view usage = R"(nhdyn id --model MODEL [--strict]
     {"q": [n], "qd": [n], "qdd": [n]}        ->  {"tau": [n]}         tau = rne(q, qd, qdd)
   Model with a constraint (m = n - k actuator velocities; paper5: eta = (v, omega, qd4, qd5)):
     {"q": [n], "eta": [m], "eta_dot": [m]}   ->  {"tau": [m], "lambda": [k]}
-  A URDF model is a tree without a constraint (the first form; q in `nhdyn model` order).
+  A URDF model is a tree without a constraint (the first form; q in `nhdyn model` order); a
+  robot file with a constraint takes the second form (eta as `nhdyn model` names it).
   Keys must be exactly those of the model's form; anything else is an error line.
   --strict: a URDF inertia that is not physically valid is an error instead of a warning.
 )";
@@ -32,6 +33,16 @@ ordered_json holonomic(const nhdyn::chain<double>& ch, const line& l) {
 int run(const std::vector<std::string>& args) {
   const auto any = start_any_model_command(args, usage);
   if (!any) return 0;  // --help
+  if (any->tree && any->tree_constraint) {  // a robot file: (q, η, η̇) -> (τ, λ)
+    const auto& t = *any->tree;
+    const auto& c = *any->tree_constraint;
+    const auto id = nhdyn::inverse_dynamics_with_forces(t, c);
+    return run_lines(std::cin, std::cout, [&](const line& l) {
+      l.expect_keys({"q", "eta", "eta_dot"});
+      const auto f = id(l.vector("q", c.dof()), l.vector("eta", c.m()), l.vector("eta_dot", c.m()));
+      return ordered_json{{"tau", to_json(Eigen::VectorXd(f.tau))}, {"lambda", to_json(Eigen::VectorXd(f.lambda))}};
+    });
+  }
   if (any->tree) {
     const auto& t = *any->tree;
     const auto id = nhdyn::rne(t);

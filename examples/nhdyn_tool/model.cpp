@@ -16,7 +16,8 @@ constexpr std::string_view usage = R"(nhdyn model --model MODEL [--strict]
   eta names the entries of eta (the actuator velocities of a model with a constraint:
   "v" forward speed, "omega" yaw rate (the heading joint's rate), the other joints); without a constraint eta is
   the joint names and k is 0. DH models name their joints joint1...jointn; a URDF's joints
-  keep their names, movable joints only, in the documented order (docs/trees-and-urdf.md).
+  keep their names, movable joints only, in the documented order (docs/trees-and-urdf.md);
+  a robot file's planar base adds base_x, base_y, base_yaw in front.
   --strict: a URDF inertia that is not physically valid is an error instead of a warning.
 )";
 
@@ -38,7 +39,14 @@ int run(const std::vector<std::string>& args) {
   ordered_json out;
   if (model->tree) {
     const auto& t = *model->tree;
-    out = describe(t.name(), t.joint_names(), t.joint_names(), 0, t.gravity());
+    const auto joints = t.joint_names();
+    if (model->tree_constraint) {  // a robot file's planar base: η = (v, ω, the URDF's joint rates)
+      std::vector<std::string> eta{"v", "omega"};
+      eta.insert(eta.end(), joints.begin() + 3, joints.end());
+      out = describe(model->name(), joints, eta, 1, t.gravity());
+    } else {
+      out = describe(model->name(), joints, joints, 0, t.gravity());
+    }
   } else {
     const auto& m = *model->dh;
     const auto joints = nhdyn::as_tree(m.chain).joint_names();

@@ -4,8 +4,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <fstream>
 #ifdef NHDYN_TOOL_URDF
-#include <nhdyn/io/urdf.hpp>
+#include <nhdyn/io/robot_file.hpp>
 #endif
 #include <cmath>
 #include <iostream>
@@ -61,12 +62,26 @@ bool is_urdf(const std::string& spec) {
   return ext == ".urdf";
 }
 
+/// Whether MODEL is a robot file: a JSON object with a "urdf" key.
+bool is_robot_file(const std::string& spec) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(spec, ec)) return false;
+  std::ifstream in(spec);
+  const auto j = json::parse(in, nullptr, false);
+  return j.is_object() && j.contains("urdf");
+}
+
 any_model load_any_model(const std::string& spec, bool strict) {
-  if (!is_urdf(spec)) return {load_model(spec), std::nullopt};
+  const bool robot = !is_urdf(spec) && is_robot_file(spec);
+  if (!is_urdf(spec) && !robot) return {load_model(spec), std::nullopt, std::nullopt};
 #ifdef NHDYN_TOOL_URDF
   nhdyn::io::urdf_options o;
   o.strict = strict;
-  return {std::nullopt, nhdyn::io::load_urdf(spec, o)};
+  if (robot) {
+    auto r = nhdyn::io::load_robot_file(spec, o);
+    return {std::nullopt, std::move(r.model), r.constraint};
+  }
+  return {std::nullopt, nhdyn::io::load_urdf(spec, o), std::nullopt};
 #else
   (void)strict;
   throw nhdyn::model_error(spec + ": this nhdyn was built without URDF support (urdfdom, tinyxml2)");
@@ -84,9 +99,9 @@ std::optional<any_model> start_any_model_command(const std::vector<std::string>&
 }
 
 nhdyn::io::model<double> load_model(const std::string& spec) {
-  if (is_urdf(spec))
-    throw nhdyn::model_error(spec + ": URDF models work with `nhdyn model`, `id` and `fd` so far; this command "
-                                    "takes a preset or a JSON model");
+  if (is_urdf(spec) || is_robot_file(spec))
+    throw nhdyn::model_error(spec + ": URDF models and robot files work with `nhdyn model`, `id` and `fd` so far; "
+                                    "this command takes a preset or a JSON model");
   // A shipped model by its name (share/nhdyn/models/NAME.json) when it is neither a preset
   // nor a file.
   std::error_code ec;

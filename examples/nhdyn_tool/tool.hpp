@@ -63,11 +63,13 @@ std::optional<nhdyn::io::model<double>> start_model_command(const std::vector<st
 struct any_model {
   std::optional<nhdyn::io::model<double>> dh;
   std::optional<nhdyn::tree<double>> tree;
+  /// A robot file's constraint on the tree (its planar base's no-slip condition).
+  std::optional<nhdyn::differential_drive<double>> tree_constraint;
   const std::string& name() const { return dh ? dh->chain.name() : tree->name(); }
 };
 /// Whether MODEL names a URDF file (its extension is .urdf, any case).
 bool is_urdf(const std::string& spec);
-/// load_model, and URDF files (*.urdf); `strict`: a non-physical inertia in a URDF is an error
+/// load_model, URDF files (*.urdf) and robot files (JSON with a "urdf" key); `strict`: a non-physical inertia in a URDF is an error
 /// instead of a warning on stderr.
 any_model load_any_model(const std::string& spec, bool strict = false);
 /// start_model_command for the subcommands that take any model: `--model MODEL [--strict]`.

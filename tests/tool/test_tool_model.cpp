@@ -10,7 +10,9 @@
 #include <filesystem>
 #include <fstream>
 #include <nhdyn/dynamics/reference.hpp>
+#include <nhdyn/dynamics/tree.hpp>
 #include <nhdyn/io/json.hpp>
+#include <nhdyn/io/robot_file.hpp>
 #include <nhdyn/io/urdf.hpp>
 #include <random>
 #include <sstream>
@@ -138,5 +140,41 @@ TEST_CASE("tool: id and fd on a URDF equal the reference rne and invert each oth
   CHECK(bad.status == 1);
   const auto lin = run_tool("linearize --model '" + urdf_path + "'");
   CHECK(lin.status == 1);
-  CHECK(lin.err.find("URDF models work with") != std::string::npos);
+  CHECK(lin.err.find("URDF models and robot files work with") != std::string::npos);
+}
+
+TEST_CASE("tool: a robot file (URDF on a planar base, no-slip constraint) in model, id and fd") {
+  const std::string file = std::string(NHDYN_SOURCE_DIR) + "/examples/robots/mobile_manipulator.json";
+  auto r = run_tool("model --model '" + file + "'");
+  REQUIRE(r.status == 0);
+  const json j = json::parse(r.lines[0]);
+  CHECK(j["dof"] == 19);
+  CHECK(j["k"] == 1);
+  CHECK(j["joints"][0] == "base_x");
+  CHECK(j["joints"][2] == "base_yaw");
+  CHECK(j["eta"].size() == 18);
+  CHECK(j["eta"][0] == "v");
+  CHECK(j["eta"][1] == "omega");
+  CHECK(j["eta"][2] == "wheel_left_joint");
+  // id through the tool, then fd through the tool, recovers η̇; τ equals Sᵀ(M q̈ + h) by CRBA
+  const auto robot = nhdyn::io::load_robot_file(file);
+  const auto& c = *robot.constraint;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const VectorXd q = VectorXd::NullaryExpr(19, [&] { return u(rng); });
+  const VectorXd eta = VectorXd::NullaryExpr(18, [&] { return u(rng); });
+  const VectorXd eta_dot = VectorXd::NullaryExpr(18, [&] { return u(rng); });
+  const auto id = run_tool("id --model '" + file + "'",
+                           R"({"q": )" + arr(q) + R"(, "eta": )" + arr(eta) + R"(, "eta_dot": )" + arr(eta_dot) + "}\n");
+  REQUIRE(id.status == 0);
+  const VectorXd tau = field(id.lines[0], "tau");
+  const Eigen::MatrixXd S = c.S(q);
+  const VectorXd qd = S * eta, qdd = S * eta_dot + c.Sdot(q, qd) * eta;
+  const VectorXd ref = S.transpose() * (nhdyn::mass_matrix(robot.model)(q) * qdd + nhdyn::bias(robot.model)(q, qd));
+  CHECK((tau - ref).norm() <= 1e-12 * std::max(1.0, ref.norm()));
+  const auto fd = run_tool("fd --model '" + file + "'",
+                           R"({"q": )" + arr(q) + R"(, "eta": )" + arr(eta) + R"(, "tau": )" + arr(tau) + "}\n");
+  REQUIRE(fd.status == 0);
+  const VectorXd ed = field(fd.lines[0], "eta_dot");
+  CHECK((ed - eta_dot).norm() <= 1e-8 * std::max(1.0, eta_dot.norm()));
 }

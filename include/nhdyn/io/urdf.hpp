@@ -44,6 +44,10 @@ struct urdf_options {
   vec3<double> gravity{0, 0, -9.81};
   /// Where warnings go; default: one line each on stderr, prefixed "nhdyn: warning: ".
   std::function<void(const std::string&)> warn{};
+  /// A planar base in front of the URDF's joints: q = (base_x, base_y, base_yaw, the URDF's
+  /// joints), the root link's pose on the floor (x, y along the world axes, yaw about world
+  /// z). The root link then moves: its own <inertial> and those of links fixed to it count.
+  bool planar_base = false;
 };
 
 namespace detail {
@@ -158,6 +162,22 @@ inline tree<double> parse_urdf(const std::string& text, const std::string& where
   };
   std::map<std::string, placed> where_is;
   where_is[root->name] = {-1, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
+  if (opt.planar_base) {
+    // base_x, base_y slide along the world x and y axes, base_yaw turns about world z and
+    // carries the root link (massless bodies in front: the root link's inertia is its own).
+    const char* names[3] = {"base_x", "base_y", "base_yaw"};
+    for (int i = 0; i < 3; ++i) {
+      body<double> b;
+      b.name = i == 2 ? root->name : names[i] + std::string("_link");
+      b.joint_name = names[i];
+      b.parent = i - 1;
+      b.joint = i == 2 ? joint_type::revolute : joint_type::prismatic;
+      b.continuous = i == 2;
+      b.axis = i == 0 ? Eigen::Vector3d::UnitX() : i == 1 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
+      bodies.push_back(std::move(b));
+    }
+    where_is[root->name] = {2, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
+  }
 
   // A link's own inertial, checked, in the frame of the body it joins.
   const auto add_inertial = [&](const urdf::Link& L, const placed& pl) {
@@ -285,6 +305,7 @@ inline tree<double> parse_urdf(const std::string& text, const std::string& where
     where_is[link_name] = {static_cast<int>(bodies.size()) - 1, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
     add_inertial(*L, where_is[link_name]);
   }
+  if (opt.planar_base) add_inertial(*root, where_is[root->name]);
   if (visits.size() != model->links_.size())
     for (const auto& [name, l] : model->links_)
       if (!visits.count(name)) throw model_error(at + "link '" + name + "'" + line_of_link(name) + " is not connected to the root '" + root->name + "'");
@@ -292,7 +313,8 @@ inline tree<double> parse_urdf(const std::string& text, const std::string& where
   validation v;
   v.triangle_inequality = false;  // checked per link above (warning or error)
   v.positive_semidefinite = false;
-  return tree<double>(std::move(bodies), opt.gravity, model->getName(), v, root->name, std::move(frames));
+  return tree<double>(std::move(bodies), opt.gravity, model->getName(), v, opt.planar_base ? "world" : root->name,
+                      std::move(frames));
 }
 
 /// The URDF file at `path` as a tree; messages name the file.
