@@ -23,6 +23,19 @@ namespace {
 
 double rel(const MatrixXd& a, const MatrixXd& b) { return (a - b).norm() / std::max(1.0, b.norm()); }
 
+/// paper5's planar base (its first three bodies of t = as_tree(paper5)) carrying a random
+/// branching tree of `arm` bodies, under vertical gravity.
+tree<double> base_with_branches(const tree<double>& t, std::mt19937_64& rng, int arm) {
+  std::vector<body<double>> B = {t[0], t[1], t[2]};
+  const tree<double> arms = nhdyn_ref::random_tree(rng, arm);
+  for (int i = 0; i < arms.dof(); ++i) {
+    body<double> b = arms[i];
+    b.parent = b.parent < 0 ? 2 : b.parent + 3;
+    B.push_back(b);
+  }
+  return tree<double>(B, Eigen::Vector3d(0, 0, -9.81), "base with branches");
+}
+
 VectorXd random_state(std::mt19937_64& rng, int n, double r = 1.5) {
   VectorXd v(n);
   for (int i = 0; i < n; ++i) v(i) = nhdyn_ref::uniform(rng, -r, r);
@@ -238,14 +251,7 @@ TEST_CASE("the nonholonomic stages run on trees: project ∘ rne ∘ lift, λ an
     CHECK(rel(nh_forward_dynamics(t, dd)(q, eta, tau_t), eta_dot) < 1e-10);
   }
   // a base (x, y prismatic, heading revolute) carrying two branches
-  std::vector<body<double>> B = {t[0], t[1], t[2]};
-  const tree<double> arms = nhdyn_ref::random_tree(rng, 6);
-  for (int i = 0; i < arms.dof(); ++i) {
-    body<double> b = arms[i];
-    b.parent = b.parent < 0 ? 2 : b.parent + 3;
-    B.push_back(b);
-  }
-  const tree<double> mm(B, Eigen::Vector3d(0, 0, -9.81), "base with branches");
+  const tree<double> mm = base_with_branches(t, rng, 6);
   const differential_drive<double> c(mm.dof(), 0, 1, 2);
   const auto id = inverse_dynamics(mm, c);
   const auto fd = nh_forward_dynamics(mm, c);
@@ -275,14 +281,7 @@ TEST_CASE("the linearizers run on trees: the chain's numbers on paper5, central 
   CHECK(rel(At.A, Ac.A) < 1e-10);
   CHECK(rel(At.B, Ac.B) < 1e-10);
   // a branching tree under a differential drive: the dual Jacobian equals central differences
-  std::vector<body<double>> B = {t[0], t[1], t[2]};
-  const tree<double> arms = nhdyn_ref::random_tree(rng, 5);
-  for (int i = 0; i < arms.dof(); ++i) {
-    body<double> b = arms[i];
-    b.parent = b.parent < 0 ? 2 : b.parent + 3;
-    B.push_back(b);
-  }
-  const tree<double> mm(B, Eigen::Vector3d(0, 0, -9.81), "base with branches");
+  const tree<double> mm = base_with_branches(t, rng, 5);
   const differential_drive<double> c(mm.dof(), 0, 1, 2);
   const int n = mm.dof(), m = c.m();
   VectorXd z(n + 2 * m);
