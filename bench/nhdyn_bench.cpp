@@ -9,6 +9,10 @@
 ///   rne/<tree>/{nhdyn, reference, kdl}          rne on kinematic trees (the kernel, the plain
 ///   crba/<tree>/{nhdyn, reference}               spatial-algebra reference, KDL's tree solver);
 ///                                               mass matrix by the kernel and the reference
+///   nh_id/<robot>/{rne, lagrange}               a robot file's nonholonomic inverse dynamics
+///   nh_pair/<robot>/run_time                     (robot: mobile_manipulator_{ddrive, wheels,
+///   nh_fd/<robot>/nhdyn                          bicycle}) vs projected E–L on the tree, paired
+///                                               with the holonomic rne, and its forward dynamics
 /// Every case checks its answer once, untimed, against an independent computation (KDL, the
 /// Lagrangian, the run-time-sized variant) and aborts on disagreement; every case reports
 /// `allocs_per_call`, the heap allocations of one call (counted by alloc_counter.cpp).
@@ -24,6 +28,7 @@
 #include <nhdyn/dynamics/reference.hpp>
 #include <nhdyn/dynamics/tree.hpp>
 #ifdef NHDYN_BENCH_URDF
+#include <nhdyn/io/robot_file.hpp>
 #include <nhdyn/io/urdf.hpp>
 #endif
 #include <reference/random_tree.hpp>
@@ -392,6 +397,59 @@ void register_tree(const std::string& model, const nhdyn::tree<double>& t) {
 }
 
 }  // namespace
+#ifdef NHDYN_BENCH_URDF
+/// A robot file's constrained robot (a tree and one of its constraint types): the paper's
+/// method against the projected Euler–Lagrange formulation on the tree, paired with the
+/// holonomic rne at the lifted state, and the constrained forward dynamics.
+template <class C>
+void register_wheeled(const std::string& model, const nhdyn::tree<double>& t, const C& c) {
+  const int n = c.dof(), m = c.m();
+  const state s = random_state(n);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  const Eigen::VectorXd q = s.q, eta = Eigen::VectorXd::NullaryExpr(m, [&] { return U(rng); }),
+                        eta_dot = Eigen::VectorXd::NullaryExpr(m, [&] { return U(rng); }),
+                        tau_in = Eigen::VectorXd::NullaryExpr(m, [&] { return U(rng); });
+  auto id = nhdyn::inverse_dynamics(t, c);
+  projected_lagrange<C, tree_lagrange_terms> el(t, c);
+  const Eigen::VectorXd tau = id(q, eta, eta_dot);
+  agree(tau, el(q, eta, eta_dot), 1e-10, "nh_id/" + model + ": rne vs projected Lagrange");
+  add("nh_id/" + model + "/rne", [id, q, eta, eta_dot]() mutable {
+    opaque(q), opaque(eta), opaque(eta_dot);
+    auto r = id(q, eta, eta_dot);
+    benchmark::DoNotOptimize(r);
+  });
+  add("nh_id/" + model + "/lagrange", [el, q, eta, eta_dot]() mutable {
+    opaque(q), opaque(eta), opaque(eta_dot);
+    auto r = el(q, eta, eta_dot);
+    benchmark::DoNotOptimize(r);
+  });
+  const auto xi = nhdyn::lift(c)(q, eta, eta_dot);
+  const Eigen::VectorXd xq = xi.q, xqd = xi.qd, xqdd = xi.qdd;
+  auto rn = nhdyn::rne(t);
+  agree(nhdyn::apply_St(c, q, rn(xq, xqd, xqdd)), tau, 1e-14, "nh_pair/" + model + ": Sᵀ rne(lift) vs nh");
+  add_paired(
+      "nh_pair/" + model + "/run_time",
+      [rn, xq, xqd, xqdd]() mutable {
+        opaque(xq), opaque(xqd), opaque(xqdd);
+        auto v = rn(xq, xqd, xqdd);
+        benchmark::DoNotOptimize(v);
+      },
+      [id, q, eta, eta_dot]() mutable {
+        opaque(q), opaque(eta), opaque(eta_dot);
+        auto r = id(q, eta, eta_dot);
+        benchmark::DoNotOptimize(r);
+      });
+  auto fd = nhdyn::nh_forward_dynamics(t, c);
+  agree(fd(q, eta, tau), eta_dot, 1e-9, "nh_fd/" + model + ": forward dynamics inverts inverse dynamics");
+  add("nh_fd/" + model + "/nhdyn", [fd, q, eta, tau_in]() mutable {
+    opaque(q), opaque(eta), opaque(tau_in);
+    auto r = fd(q, eta, tau_in);
+    benchmark::DoNotOptimize(r);
+  });
+}
+#endif
+
 }  // namespace nhdyn_bench
 
 int main(int argc, char** argv) {
@@ -424,6 +482,12 @@ int main(int argc, char** argv) {
 
 #ifdef NHDYN_BENCH_URDF
   register_tree("mobile_manipulator", nhdyn::io::load_urdf(NHDYN_SOURCE_DIR "/examples/urdf/mobile_manipulator.urdf"));
+  for (const auto& [name, file] : {std::pair{"mobile_manipulator_ddrive", "mobile_manipulator.json"},
+                                   std::pair{"mobile_manipulator_wheels", "mobile_manipulator_wheels.json"},
+                                   std::pair{"mobile_manipulator_bicycle", "mobile_manipulator_bicycle.json"}}) {
+    const auto r = nhdyn::io::load_robot_file(std::string(NHDYN_SOURCE_DIR "/examples/robots/") + file);
+    std::visit([&](const auto& c) { register_wheeled(name, r.model, c); }, *r.constraint);
+  }
 #endif
   std::mt19937_64 tree_rng(41);
   for (int n : {12, 24, 48})  // branching trees, URDF-like (no body offsets)

@@ -284,6 +284,34 @@ TEST_CASE("docs/api.md §6: paper5's constraint has the A and S of paper5.md, A 
   CHECK((Sdot - fd).norm() < 1e-9);
 }
 
+TEST_CASE("docs/api.md §6: wheeled bases: the wheels' and the bicycle's S give the closed-form planar motions") {
+  const int n = 6;  // x, y, heading, two wheels (or a steering joint and one more), an arm joint
+  // snippet
+  // two drive wheels (joints 3, 4) of radius 0.1 m at y = ±0.26 m on an axle through the base
+  // origin; k = 3, η = (φ̇_left, φ̇_right, the other joints' rates)
+  const nhdyn::rolling_wheels<double> wheels(n, 3, 4, 0.1, 0.26, -0.26);
+  // a car-like base: steering joint 3, wheelbase 0.24 m; k = 2, η = (v, δ̇, the others' rates)
+  const nhdyn::bicycle<double> car(n, 3, 0.24);
+  // end snippet
+  CHECK(wheels.k() == 3);
+  CHECK(car.k() == 2);
+  Eigen::Matrix<double, 6, 1> q;
+  q << 1.0, -2.0, 0.4, 0.3, -0.7, 0.2;
+  // both wheels at 2 rad/s: straight ahead at r·φ̇ = 0.2 m/s along the heading, no turning
+  Eigen::VectorXd qd = wheels.S(q) * Eigen::Vector3d(2, 2, 0);
+  CHECK(qd(0) == Approx(0.2 * std::cos(0.4)));
+  CHECK(qd(1) == Approx(0.2 * std::sin(0.4)));
+  CHECK(qd(2) == Approx(0).margin(1e-15));
+  // opposite rates: turning on the spot at ω = r(φ̇_R − φ̇_L)/track = 0.1·4/0.52
+  qd = wheels.S(q) * Eigen::Vector3d(-2, 2, 0);
+  CHECK(qd.head(2).norm() == Approx(0).margin(1e-15));
+  CHECK(qd(2) == Approx(0.4 / 0.52));
+  // the bicycle at v = 1 m/s and steering angle q₃ = 0.3: ψ̇ = tan(0.3) / 0.24
+  qd = car.S(q) * Eigen::Vector4d(1, 0, 0, 0);
+  CHECK(qd(2) == Approx(std::tan(0.3) / 0.24));
+  CHECK(Eigen::Vector2d(qd(0), qd(1)).norm() == Approx(1));
+}
+
 TEST_CASE("docs/api.md §7: the pipeline's τ equals Sᵀ·rne(q, Sη, Sη̇ + Ṡη) with S and Ṡ written by hand") {
   // snippet
   const auto robot = nhdyn::presets::paper5();

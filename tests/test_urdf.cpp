@@ -336,7 +336,7 @@ TEST_CASE("robot files: a URDF on a planar base with the no-slip constraint runs
   const io::robot_model r = io::load_robot_file(dir + "robots/mobile_manipulator.json");
   const tree<double>& t = r.model;
   REQUIRE(r.constraint);
-  const auto& c = *r.constraint;
+  const auto& c = std::get<differential_drive<double>>(*r.constraint);
   REQUIRE(t.dof() == 19);
   CHECK(t[0].joint_name == "base_x");
   CHECK(t[1].joint_name == "base_y");

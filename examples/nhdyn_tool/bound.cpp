@@ -13,13 +13,15 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn bound --model MODEL
+constexpr std::string_view usage = R"(nhdyn bound --model MODEL [--strict]
   Guaranteed bounds on the torques over a box of states (interval arithmetic, outward rounding).
   Reads JSON lines on stdin, writes one JSON line per input line. Each box side is [lo, hi].
   Model with a constraint (n joints, m actuator velocities):
     {"q": [[lo, hi]] x n, "eta": [..] x m, "eta_dot": [..] x m [, "split": k]}  ->  {"tau": [[lo, hi]] x m}
   Model without a constraint:
     {"q": [..] x n, "qd": [..] x n, "qdd": [..] x n [, "split": k]}          ->  {"tau": [[lo, hi]] x n}
+  A URDF model is a tree without a constraint (the second form); a robot file with a
+  constraint takes the first form (q and eta as `nhdyn model` names them).
   split k (0..20, default 0): bisect the box k times, widest side first (2^k sub-boxes), and
   return the hull of their enclosures (tighter, 2^k times the work).
   Every true torque for every state in the box lies in the printed [lo, hi]: inputs are rounded
@@ -43,32 +45,42 @@ ordered_json reply(const nhdyn::vecN<nhdyn::interval, nhdyn::dynamic>& t) {
 
 int split_of(const line& l) { return l.has("split") ? l.integer("split", 20) : 0; }
 
-int run(const std::vector<std::string>& args) {
-  const auto model = start_model_command(args, usage);
-  if (!model) return 0;  // --help
-  const auto& m = *model;
-  const auto& ch = m.chain;
-  const int n = ch.dof();
-  const auto keys = [](const line& l, std::vector<std::string> k) {
-    if (l.has("split")) k.push_back("split");
-    l.expect_keys(k);
-  };
-  if (!m.constraint)
-    return run_lines(std::cin, std::cout, [&](const line& l) {
-      if (l.has("eta"))
-        throw nhdyn::input_error("model '" + ch.name() + "' has no constraint: lines are {\"q\", \"qd\", \"qdd\"}");
-      keys(l, {"q", "qd", "qdd"});
-      return reply(nhdyn::torque_bounds(ch, box_of(l, "q", n), box_of(l, "qd", n), box_of(l, "qdd", n), split_of(l)));
-    });
-  const auto& c = *m.constraint;
+void keys(const line& l, std::vector<std::string> k) {
+  if (l.has("split")) k.push_back("split");
+  l.expect_keys(k);
+}
+
+/// Lines of a model with a constraint: boxes of (q, η, η̇) -> τ.
+template <class Model, class C>
+int constrained(const Model& model, const C& c, const std::string& name) {
+  const int n = c.dof();
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("qd"))
-      throw nhdyn::input_error("model '" + ch.name() + "' has a constraint: lines are {\"q\", \"eta\", \"eta_dot\"} (eta has " +
+      throw nhdyn::input_error("model '" + name + "' has a constraint: lines are {\"q\", \"eta\", \"eta_dot\"} (eta has " +
                                std::to_string(c.m()) + " entries)");
     keys(l, {"q", "eta", "eta_dot"});
-    return reply(nhdyn::torque_bounds(ch, c, box_of(l, "q", n), box_of(l, "eta", c.m()), box_of(l, "eta_dot", c.m()),
+    return reply(nhdyn::torque_bounds(model, c, box_of(l, "q", n), box_of(l, "eta", c.m()), box_of(l, "eta_dot", c.m()),
                                       split_of(l)));
   });
+}
+/// Lines of a holonomic model: boxes of (q, q̇, q̈) -> τ.
+template <class Model>
+int holonomic(const Model& model, const std::string& name) {
+  const int n = model.dof();
+  return run_lines(std::cin, std::cout, [&](const line& l) {
+    if (l.has("eta"))
+      throw nhdyn::input_error("model '" + name + "' has no constraint: lines are {\"q\", \"qd\", \"qdd\"}");
+    keys(l, {"q", "qd", "qdd"});
+    return reply(nhdyn::torque_bounds(model, box_of(l, "q", n), box_of(l, "qd", n), box_of(l, "qdd", n), split_of(l)));
+  });
+}
+
+int run(const std::vector<std::string>& args) {
+  const auto any = start_any_model_command(args, usage);
+  if (!any) return 0;  // --help
+  return dispatch(
+      *any, [&](const auto& model, const auto& c) { return constrained(model, c, any->name()); },
+      [&](const auto& model) { return holonomic(model, any->name()); });
 }
 }  // namespace
 

@@ -25,15 +25,17 @@ constexpr std::string_view usage = R"(nhdyn fd --model MODEL [--strict]
 int run(const std::vector<std::string>& args) {
   const auto any = start_any_model_command(args, usage);
   if (!any) return 0;  // --help
-  if (any->tree && any->tree_constraint) {  // a robot file: (q, η, τ) -> η̇
-    const auto& c = *any->tree_constraint;
-    const auto fd = nhdyn::nh_forward_dynamics(*any->tree, c);
-    return run_lines(std::cin, std::cout, [&](const line& l) {
-      l.expect_keys({"q", "eta", "tau"});
-      const Eigen::VectorXd eta_dot = fd(l.vector("q", c.dof()), l.vector("eta", c.m()), l.vector("tau", c.m()));
-      return ordered_json{{"eta_dot", to_json(eta_dot)}};
-    });
-  }
+  if (any->tree && any->tree_constraint)  // a robot file: (q, η, τ) -> η̇
+    return std::visit(
+        [&](const auto& c) {
+          const auto fd = nhdyn::nh_forward_dynamics(*any->tree, c);
+          return run_lines(std::cin, std::cout, [&](const line& l) {
+            l.expect_keys({"q", "eta", "tau"});
+            const Eigen::VectorXd eta_dot = fd(l.vector("q", c.dof()), l.vector("eta", c.m()), l.vector("tau", c.m()));
+            return ordered_json{{"eta_dot", to_json(eta_dot)}};
+          });
+        },
+        *any->tree_constraint);
   if (any->tree) {
     const auto& t = *any->tree;
     const auto fd = nhdyn::forward_dynamics(t);

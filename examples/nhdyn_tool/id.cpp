@@ -33,16 +33,17 @@ ordered_json holonomic(const nhdyn::chain<double>& ch, const line& l) {
 int run(const std::vector<std::string>& args) {
   const auto any = start_any_model_command(args, usage);
   if (!any) return 0;  // --help
-  if (any->tree && any->tree_constraint) {  // a robot file: (q, η, η̇) -> (τ, λ)
-    const auto& t = *any->tree;
-    const auto& c = *any->tree_constraint;
-    const auto id = nhdyn::inverse_dynamics_with_forces(t, c);
-    return run_lines(std::cin, std::cout, [&](const line& l) {
-      l.expect_keys({"q", "eta", "eta_dot"});
-      const auto f = id(l.vector("q", c.dof()), l.vector("eta", c.m()), l.vector("eta_dot", c.m()));
-      return ordered_json{{"tau", to_json(Eigen::VectorXd(f.tau))}, {"lambda", to_json(Eigen::VectorXd(f.lambda))}};
-    });
-  }
+  if (any->tree && any->tree_constraint)  // a robot file: (q, η, η̇) -> (τ, λ)
+    return std::visit(
+        [&](const auto& c) {
+          const auto id = nhdyn::inverse_dynamics_with_forces(*any->tree, c);
+          return run_lines(std::cin, std::cout, [&](const line& l) {
+            l.expect_keys({"q", "eta", "eta_dot"});
+            const auto f = id(l.vector("q", c.dof()), l.vector("eta", c.m()), l.vector("eta_dot", c.m()));
+            return ordered_json{{"tau", to_json(Eigen::VectorXd(f.tau))}, {"lambda", to_json(Eigen::VectorXd(f.lambda))}};
+          });
+        },
+        *any->tree_constraint);
   if (any->tree) {
     const auto& t = *any->tree;
     const auto id = nhdyn::rne(t);

@@ -11,7 +11,7 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn linearize --model MODEL
+constexpr std::string_view usage = R"(nhdyn linearize --model MODEL [--strict]
   Exact linearisation of the forward dynamics (derivatives by dual numbers, no step size).
   Reads JSON lines on stdin, writes one JSON line per input line; A and B are row-major.
   Model with a constraint (n joints, m actuator velocities; paper5: n = 5, m = 4):
@@ -20,33 +20,46 @@ constexpr std::string_view usage = R"(nhdyn linearize --model MODEL
   Model without a constraint (n joints):
     {"q": [n], "qd": [n], "tau": [n]}   ->  {"A": [[2n] x 2n], "B": [[n] x 2n]}
         x = (q, qd), f = (qd, qdd)
+  A URDF model is a tree without a constraint (the second form; q in `nhdyn model` order); a
+  robot file with a constraint takes the first form (eta as `nhdyn model` names it).
   A singular (reduced) mass matrix is an error line.
+  --strict: a URDF inertia that is not physically valid is an error instead of a warning.
 )";
 
-int run(const std::vector<std::string>& args) {
-  const auto model = start_model_command(args, usage);
-  if (!model) return 0;  // --help
-  const auto& m = *model;
-  const auto& ch = m.chain;
-  const int n = ch.dof();
-  const auto reply = [](const auto& ss) {
-    return ordered_json{{"A", to_json(Eigen::MatrixXd(ss.A))}, {"B", to_json(Eigen::MatrixXd(ss.B))}};
-  };
-  if (!m.constraint)
-    return run_lines(std::cin, std::cout, [&](const line& l) {
-      if (l.has("eta"))
-        throw nhdyn::input_error("model '" + ch.name() + "' has no constraint: lines are {\"q\", \"qd\", \"tau\"}");
-      l.expect_keys({"q", "qd", "tau"});
-      return reply(nhdyn::linearize_forward_dynamics(ch, l.vector("q", n), l.vector("qd", n), l.vector("tau", n)));
-    });
-  const auto& c = *m.constraint;
+ordered_json reply(const auto& ss) {
+  return ordered_json{{"A", to_json(Eigen::MatrixXd(ss.A))}, {"B", to_json(Eigen::MatrixXd(ss.B))}};
+}
+
+/// Lines of a model with a constraint: (q, η, τ) -> (A, B).
+template <class Model, class C>
+int constrained(const Model& model, const C& c, const std::string& name) {
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("qd"))
-      throw nhdyn::input_error("model '" + ch.name() + "' has a constraint: lines are {\"q\", \"eta\", \"tau\"} (eta and tau have " +
+      throw nhdyn::input_error("model '" + name + "' has a constraint: lines are {\"q\", \"eta\", \"tau\"} (eta and tau have " +
                                std::to_string(c.m()) + " entries)");
     l.expect_keys({"q", "eta", "tau"});
-    return reply(nhdyn::linearize_forward_dynamics(ch, c, l.vector("q", n), l.vector("eta", c.m()), l.vector("tau", c.m())));
+    return reply(nhdyn::linearize_forward_dynamics(model, c, l.vector("q", c.dof()), l.vector("eta", c.m()),
+                                                   l.vector("tau", c.m())));
   });
+}
+/// Lines of a holonomic model: (q, q̇, τ) -> (A, B).
+template <class Model>
+int holonomic(const Model& model, const std::string& name) {
+  const int n = model.dof();
+  return run_lines(std::cin, std::cout, [&](const line& l) {
+    if (l.has("eta"))
+      throw nhdyn::input_error("model '" + name + "' has no constraint: lines are {\"q\", \"qd\", \"tau\"}");
+    l.expect_keys({"q", "qd", "tau"});
+    return reply(nhdyn::linearize_forward_dynamics(model, l.vector("q", n), l.vector("qd", n), l.vector("tau", n)));
+  });
+}
+
+int run(const std::vector<std::string>& args) {
+  const auto any = start_any_model_command(args, usage);
+  if (!any) return 0;  // --help
+  return dispatch(
+      *any, [&](const auto& model, const auto& c) { return constrained(model, c, any->name()); },
+      [&](const auto& model) { return holonomic(model, any->name()); });
 }
 }  // namespace
 

@@ -14,7 +14,8 @@ constexpr std::string_view usage = R"(nhdyn model --model MODEL [--strict]
     {"name": ..., "dof": n, "joints": [n names, q order], "eta": [m names], "k": k,
      "gravity": [gx, gy, gz]}
   eta names the entries of eta (the actuator velocities of a model with a constraint:
-  "v" forward speed, "omega" yaw rate (the heading joint's rate), the other joints); without a constraint eta is
+  "v" forward speed, "omega" yaw rate (the heading joint's rate), the wheel or steering
+  joints of a wheels or bicycle constraint, the other joints); without a constraint eta is
   the joint names and k is 0. DH models name their joints joint1...jointn; a URDF's joints
   keep their names, movable joints only, in the documented order (docs/trees-and-urdf.md);
   a robot file's planar base adds base_x, base_y, base_yaw in front.
@@ -40,10 +41,10 @@ int run(const std::vector<std::string>& args) {
   if (model->tree) {
     const auto& t = *model->tree;
     const auto joints = t.joint_names();
-    if (model->tree_constraint) {  // a robot file's planar base: η = (v, ω, the URDF's joint rates)
-      std::vector<std::string> eta{"v", "omega"};
-      eta.insert(eta.end(), joints.begin() + 3, joints.end());
-      out = describe(model->name(), joints, eta, 1, t.gravity());
+    if (model->tree_constraint) {  // a robot file's constraint names η's entries
+      const auto& v = *model->tree_constraint;
+      const auto eta = std::visit([&](const auto& c) { return c.eta_names(joints); }, v);
+      out = describe(model->name(), joints, eta, std::visit([](const auto& c) { return c.k(); }, v), t.gravity());
     } else {
       out = describe(model->name(), joints, joints, 0, t.gravity());
     }
@@ -54,13 +55,7 @@ int run(const std::vector<std::string>& args) {
     int k = 0;
     if (m.constraint) {
       const auto& c = *m.constraint;
-      eta.clear();
-      for (int j = 0; j < c.n; ++j) {
-        if (j == std::max(c.x, c.y)) continue;
-        // η's entry of the heading joint is its rate q̇_h: the yaw rate ω when heading_sign is +1
-        const bool omega = j == c.heading && c.heading_sign == 1.0;
-        eta.push_back(j == std::min(c.x, c.y) ? "v" : omega ? "omega" : joints[std::size_t(j)]);
-      }
+      eta = c.eta_names(joints);
       k = c.k();
     }
     out = describe(m.chain.name(), joints, eta, k, m.chain.gravity());

@@ -100,8 +100,8 @@ std::optional<any_model> start_any_model_command(const std::vector<std::string>&
 
 nhdyn::io::model<double> load_model(const std::string& spec) {
   if (is_urdf(spec) || is_robot_file(spec))
-    throw nhdyn::model_error(spec + ": URDF models and robot files work with `nhdyn model`, `id` and `fd` so far; "
-                                    "this command takes a preset or a JSON model");
+    throw nhdyn::model_error(spec + ": URDF models and robot files work with `nhdyn model`, `id`, `fd`, `linearize` and "
+                                    "`bound` so far; this command takes a preset or a JSON model");
   // A shipped model by its name (share/nhdyn/models/NAME.json) when it is neither a preset
   // nor a file.
   std::error_code ec;

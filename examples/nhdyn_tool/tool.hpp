@@ -14,6 +14,8 @@
 #include <functional>
 #include <iosfwd>
 #include <optional>
+#include <variant>
+#include <nhdyn/constraints/constraint.hpp>
 #include <nhdyn/io/json.hpp>
 #include <nhdyn/model/tree.hpp>
 #include <string>
@@ -63,10 +65,23 @@ std::optional<nhdyn::io::model<double>> start_model_command(const std::vector<st
 struct any_model {
   std::optional<nhdyn::io::model<double>> dh;
   std::optional<nhdyn::tree<double>> tree;
-  /// A robot file's constraint on the tree (its planar base's no-slip condition).
-  std::optional<nhdyn::differential_drive<double>> tree_constraint;
+  /// A robot file's constraint on the tree (differential_drive, rolling_wheels or bicycle).
+  std::optional<nhdyn::base_constraint> tree_constraint;
   const std::string& name() const { return dh ? dh->chain.name() : tree->name(); }
 };
+/// Calls `constrained(model, c)` for a model with a constraint (a DH chain with its
+/// constraint, or a robot file's tree with its constraint type) and `holonomic(model)`
+/// otherwise (a DH chain or a URDF tree), and returns what it returns.
+template <class Constrained, class Holonomic>
+int dispatch(const any_model& a, const Constrained& constrained, const Holonomic& holonomic) {
+  if (a.tree) {
+    if (a.tree_constraint) return std::visit([&](const auto& c) { return constrained(*a.tree, c); }, *a.tree_constraint);
+    return holonomic(*a.tree);
+  }
+  if (a.dh->constraint) return constrained(a.dh->chain, *a.dh->constraint);
+  return holonomic(a.dh->chain);
+}
+
 /// Whether MODEL names a URDF file (its extension is .urdf, any case).
 bool is_urdf(const std::string& spec);
 /// load_model, URDF files (*.urdf) and robot files (JSON with a "urdf" key); `strict`: a non-physical inertia in a URDF is an error

@@ -135,12 +135,22 @@ TEST_CASE("tool: id and fd on a URDF equal the reference rne and invert each oth
     const VectorXd a = field(fd.lines[std::size_t(k)], "qdd");
     CHECK((a - qdd[std::size_t(k)]).norm() <= 1e-8 * std::max(1.0, qdd[std::size_t(k)].norm()));
   }
-  // a line of the wrong form names the keys; a command that does not take URDF says so
+  // a line of the wrong form names the keys
   const auto bad = run_tool("id --model '" + urdf_path + "'", R"({"q": [0], "eta": [0], "eta_dot": [0]})" "\n");
   CHECK(bad.status == 1);
-  const auto lin = run_tool("linearize --model '" + urdf_path + "'");
-  CHECK(lin.status == 1);
-  CHECK(lin.err.find("URDF models and robot files work with") != std::string::npos);
+  // linearize on the URDF: B's q̈ block is M⁻¹ (CRBA), A's q block top-right is I
+  const auto lin = run_tool("linearize --model '" + urdf_path + "'",
+                            R"({"q": )" + arr(q[0]) + R"(, "qd": )" + arr(qd[0]) + R"(, "tau": )" + arr(qdd[0]) + "}\n");
+  REQUIRE(lin.status == 0);
+  const json jl = json::parse(lin.lines[0]);
+  const Eigen::MatrixXd Minv = nhdyn::mass_matrix(t)(q[0]).inverse();
+  double worst = 0;
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < n; ++k) {
+      worst = std::max(worst, std::abs(jl["B"][std::size_t(n + i)][std::size_t(k)].get<double>() - Minv(i, k)));
+      CHECK(jl["A"][std::size_t(i)][std::size_t(n + k)].get<double>() == (i == k ? 1.0 : 0.0));
+    }
+  CHECK(worst <= 1e-9 * Minv.cwiseAbs().maxCoeff());
 }
 
 TEST_CASE("tool: a robot file (URDF on a planar base, no-slip constraint) in model, id and fd") {
@@ -158,7 +168,7 @@ TEST_CASE("tool: a robot file (URDF on a planar base, no-slip constraint) in mod
   CHECK(j["eta"][2] == "wheel_left_joint");
   // id through the tool, then fd through the tool, recovers η̇; τ equals Sᵀ(M q̈ + h) by CRBA
   const auto robot = nhdyn::io::load_robot_file(file);
-  const auto& c = *robot.constraint;
+  const auto& c = std::get<nhdyn::differential_drive<double>>(*robot.constraint);
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
   const VectorXd q = VectorXd::NullaryExpr(19, [&] { return u(rng); });
@@ -177,4 +187,81 @@ TEST_CASE("tool: a robot file (URDF on a planar base, no-slip constraint) in mod
   REQUIRE(fd.status == 0);
   const VectorXd ed = field(fd.lines[0], "eta_dot");
   CHECK((ed - eta_dot).norm() <= 1e-8 * std::max(1.0, eta_dot.norm()));
+}
+
+TEST_CASE("tool: robot files with each constraint type in model, id, fd, linearize and bound") {
+  for (const std::string name : {"mobile_manipulator_wheels", "mobile_manipulator_bicycle", "paper5"}) {
+    INFO(name);
+    const std::string file = std::string(NHDYN_SOURCE_DIR) + "/examples/robots/" + name + ".json";
+    const auto robot = nhdyn::io::load_robot_file(file);
+    std::visit(
+        [&](const auto& c) {
+          const int n = c.dof(), m = c.m();
+          auto r = run_tool("model --model '" + file + "'");
+          REQUIRE(r.status == 0);
+          const json j = json::parse(r.lines[0]);
+          CHECK(j["k"] == c.k());
+          CHECK(j["eta"] == json(robot.eta_names()));
+          std::mt19937_64 rng(11);
+          std::uniform_real_distribution<double> u(-0.5, 0.5);
+          const VectorXd q = VectorXd::NullaryExpr(n, [&] { return u(rng); });
+          const VectorXd eta = VectorXd::NullaryExpr(m, [&] { return u(rng); });
+          const VectorXd eta_dot = VectorXd::NullaryExpr(m, [&] { return u(rng); });
+          const std::string state = R"({"q": )" + arr(q) + R"(, "eta": )" + arr(eta);
+          // id: τ = (SᵀE)⁻¹Sᵀ(M q̈ + h) by CRBA and λ from v − Eτ = Aᵀλ
+          const auto id = run_tool("id --model '" + file + "'", state + R"(, "eta_dot": )" + arr(eta_dot) + "}\n");
+          REQUIRE(id.status == 0);
+          const VectorXd tau = field(id.lines[0], "tau"), lambda = field(id.lines[0], "lambda");
+          const Eigen::MatrixXd S = c.S(q), E = nhdyn::input_map(c, q), A = c.A(q);
+          const VectorXd qd = S * eta, qdd = S * eta_dot + c.Sdot(q, qd) * eta;
+          const VectorXd v = nhdyn::mass_matrix(robot.model)(q) * qdd + nhdyn::bias(robot.model)(q, qd);
+          const VectorXd ref = (S.transpose() * E).lu().solve(S.transpose() * v);
+          CHECK((tau - ref).norm() <= 1e-12 * std::max(1.0, ref.norm()));
+          CHECK((E * tau + A.transpose() * lambda - v).norm() <= 1e-11 * std::max(1.0, v.norm()));
+          // fd inverts id
+          const auto fd = run_tool("fd --model '" + file + "'", state + R"(, "tau": )" + arr(tau) + "}\n");
+          REQUIRE(fd.status == 0);
+          CHECK((field(fd.lines[0], "eta_dot") - eta_dot).norm() <= 1e-8 * std::max(1.0, eta_dot.norm()));
+          // linearize: the top-right block of A is S(q); the η̇ rows of B are M_η⁻¹ SᵀE
+          const auto lin = run_tool("linearize --model '" + file + "'", state + R"(, "tau": )" + arr(tau) + "}\n");
+          REQUIRE(lin.status == 0);
+          const json jl = json::parse(lin.lines[0]);
+          const Eigen::MatrixXd Meta = S.transpose() * nhdyn::mass_matrix(robot.model)(q) * S;
+          const Eigen::MatrixXd Bref = Meta.inverse() * S.transpose() * E;
+          double wa = 0, wb = 0;
+          for (int i = 0; i < n; ++i)
+            for (int k = 0; k < m; ++k) wa = std::max(wa, std::abs(jl["A"][std::size_t(i)][std::size_t(n + k)].get<double>() - S(i, k)));
+          for (int i = 0; i < m; ++i)
+            for (int k = 0; k < m; ++k) wb = std::max(wb, std::abs(jl["B"][std::size_t(n + i)][std::size_t(k)].get<double>() - Bref(i, k)));
+          CHECK(wa <= 1e-14);
+          CHECK(wb <= 1e-9 * Bref.cwiseAbs().maxCoeff());
+          // bound: a small box around the state encloses id's τ at the state
+          const auto box = [](const VectorXd& x, double w) {
+            std::string s = "[";
+            for (Eigen::Index i = 0; i < x.size(); ++i)
+              s += (i ? ", [" : "[") + nhdyn::io::format_number(x(i) - w) + ", " + nhdyn::io::format_number(x(i) + w) + "]";
+            return s + "]";
+          };
+          // bound: boxes around the state enclose id's τ there, and shrink with the box (an
+          // interval enclosure converges linearly: 10× narrower box, ≈10× narrower bounds)
+          std::vector<double> width;
+          for (double w : {1e-3, 1e-4}) {
+            const auto b = run_tool("bound --model '" + file + "'", R"({"q": )" + box(q, w) + R"(, "eta": )" + box(eta, w) +
+                                                                       R"(, "eta_dot": )" + box(eta_dot, w) + "}\n");
+            REQUIRE(b.status == 0);
+            const json jb = json::parse(b.lines[0]);
+            REQUIRE(jb["tau"].size() == std::size_t(m));
+            double widest = 0;
+            for (int i = 0; i < m; ++i) {
+              const double lo = jb["tau"][std::size_t(i)][0].get<double>(), hi = jb["tau"][std::size_t(i)][1].get<double>();
+              CHECK(lo <= tau(i));
+              CHECK(hi >= tau(i));
+              widest = std::max(widest, hi - lo);
+            }
+            width.push_back(widest);
+          }
+          CHECK(width[1] <= 0.2 * width[0]);
+        },
+        *robot.constraint);
+  }
 }

@@ -387,9 +387,11 @@ auto linearize_forward_dynamics(const tree<S>& t, const C& c, const Eigen::Matri
   return forward_dynamics_linearizer(t, c, o)(q, eta, tau);
 }
 
-/// x = (q, q̇), f = (q̇, q̈), u = τ for a holonomic chain.
-template <class S, int N, class Q, class QD, class TAU>
-auto linearize_forward_dynamics(const chain<S, N>& ch, const Eigen::MatrixBase<Q>& q,
+/// x = (q, q̇), f = (q̇, q̈), u = τ for a holonomic chain, or a tree (N = dynamic).
+template <class Model, class Q, class QD, class TAU, int N = Model::size_at_compile_time>
+  requires(std::is_same_v<Model, chain<typename Model::scalar_type, N>> ||
+           std::is_same_v<Model, tree<typename Model::scalar_type>>)
+auto linearize_forward_dynamics(const Model& ch, const Eigen::MatrixBase<Q>& q,
                                 const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                                 rne_options o = {}) {
   constexpr int Z = N == dynamic ? dynamic : 3 * N;

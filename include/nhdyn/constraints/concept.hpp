@@ -13,12 +13,13 @@
 /// the free functions below fall back to the dense forms.
 ///
 /// Built in: `holonomic` (S = I, k = 0), `differential_drive` (any x, y, heading triple of
-/// joints, forward axis a parameter), `user_constraint` (plain functions of q; Ṡ by duals
-/// when not given).
+/// joints, forward axis a parameter), `rolling_wheels` (a planar base on two drive wheels
+/// whose angles are coordinates, k = 3), `bicycle` (a car-like base with a steered front
+/// wheel, k = 2), `user_constraint` (plain functions of q; Ṡ by duals when not given).
 ///
 /// This header: the `pfaffian_constraint` concept, its optional parts, and uniform access.
 /// One header per built-in constraint type: holonomic.hpp, differential_drive.hpp,
-/// user_constraint.hpp; constraint.hpp includes them all.
+/// rolling_wheels.hpp, bicycle.hpp, user_constraint.hpp; constraint.hpp includes them all.
 #include <concepts>
 #include "../model/chain.hpp"
 
@@ -60,6 +61,11 @@ concept has_Sdot_times = requires(const C& c, const Q& q, const QD& qd, const E&
 /// Optional: the reduced inertia Sᵀ M S of a symmetric M, structured.
 template <class C, class Q, class MM>
 concept has_St_M_S = requires(const C& c, const Q& q, const MM& M) { c.St_M_S(q, M); };
+/// Optional: a constraint whose input map selects the joints whose rates η holds, so that
+/// SᵀE = I and the projection is τ = Sᵀ v (`static constexpr bool StE_identity = true`:
+/// rolling_wheels, bicycle).
+template <class C>
+concept has_identity_StE = requires { requires C::StE_identity; };
 /// Optional: which joints A, S, Ṡ, E depend on (else: all).
 template <class C>
 concept has_depends_on = requires(const C& c, int j) { c.depends_on(j); };
@@ -77,6 +83,20 @@ bool constraint_depends_on(const C& c, int j) {
 }
 
 namespace detail {
+/// The n×m matrix whose column c is f(e_c), e_c the c-th unit vector of m entries in T: a
+/// constraint's dense S or Ṡ from its structured product (S_times, Sdot_times).
+template <class T, int N, int M, class F>
+matrix<T, N, M> columns_of(int n, int m, const F& f) {
+  matrix<T, N, M> s(n, m);
+  vecN<T, M> e = vecN<T, M>::Zero(m);
+  for (int c = 0; c < m; ++c) {
+    e(c) = T(1);
+    s.col(c) = f(e);
+    e(c) = T(0);
+  }
+  return s;
+}
+
 /// Sᵀ M S in the scalar T for a symmetric M: the constraint's structured `St_M_S` when it has
 /// one (differential_drive: O(n²)), else dense products (O(n²m)).
 template <class T, class C, class Q, class MM>

@@ -3,6 +3,8 @@
 /// `differential_drive`: a planar base that cannot slip sideways, on any x, y, heading triple
 /// of joints of a chain or tree.
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "../model/dh_kernel.hpp"
 #include "concept.hpp"
@@ -73,6 +75,19 @@ struct differential_drive {
     return {T(heading_sign * qh), T(forward_offset)};  // heading_sign = ±1: exact
   }
 
+  /// Names of η's entries from the joints' names (q order): "v" in the place of the first of
+  /// x, y; "omega" for the heading joint's rate when it is the yaw rate (heading_sign +1),
+  /// else the joint's name; the other joints' names.
+  std::vector<std::string> eta_names(const std::vector<std::string>& joints) const {
+    std::vector<std::string> out;
+    for (int j = 0; j < n; ++j) {
+      if (j == std::max(x, y)) continue;
+      const bool omega = j == heading && value_of(heading_sign) == 1.0;
+      out.push_back(j == std::min(x, y) ? "v" : omega ? "omega" : joints.at(std::size_t(j)));
+    }
+    return out;
+  }
+
   template <class Q>
   auto A(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<Sc, typename Q::Scalar>;
@@ -106,14 +121,8 @@ struct differential_drive {
   }
   template <class Q, class QD>
   auto Sdot(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd) const {
-    using T = promote_t<Sc, typename Q::Scalar>;
-    matrix<T, N, m_at_compile_time> s = matrix<T, N, m_at_compile_time>::Zero(n, n - 1);
-    for (int c = 0; c < n - 1; ++c) {
-      vecN<T, m_at_compile_time> e = vecN<T, m_at_compile_time>::Zero(n - 1);
-      e(c) = T(1);
-      s.col(c) = Sdot_times(q, qd, e);
-    }
-    return s;
+    using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename QD::Scalar>;
+    return detail::columns_of<T, N, m_at_compile_time>(n, n - 1, [&](const auto& e) { return Sdot_times(q, qd, e); });
   }
   /// q̇ = S(q) η without forming S.
   template <class Q, class E>

@@ -88,7 +88,9 @@ class nh_forward_dynamics_fn : public stage_tag {
     const vecN<T, M> h = reduced_bias(q, eta);
     vecN<T, M> u;
     constexpr bool has_E = has_input_map<C, Q>;
-    if constexpr (has_E) {
+    if constexpr (has_identity_StE<C>) {
+      u = tau.template cast<T>();
+    } else if constexpr (has_E) {
       u = (c_.S(q).transpose() * c_.E(q)).template cast<T>() * tau.template cast<T>();
     } else if constexpr (C::orthonormal_S) {
       u = tau.template cast<T>();

@@ -116,9 +116,9 @@ auto solve_StE(const C& c, const Eigen::MatrixBase<Q>& q, R r) {
   constexpr int M = C::m_at_compile_time;
   using P = Eigen::Matrix<T, M, R::ColsAtCompileTime>;  // vecN<T, M> for a vector r
   constexpr bool has_E = has_input_map<C, Q>;
-  if constexpr (C::orthonormal_S && !has_E && std::is_same_v<R, P>) {
+  if constexpr (((C::orthonormal_S && !has_E) || has_identity_StE<C>) && std::is_same_v<R, P>) {
     return r;
-  } else if constexpr (C::orthonormal_S && !has_E) {
+  } else if constexpr ((C::orthonormal_S && !has_E) || has_identity_StE<C>) {
     return P(r);
   } else {
     const auto S = c.S(q);

@@ -6,30 +6,186 @@
 ///     {"name": "...", "urdf": "robot.urdf",              (the path relative to this file)
 ///      "gravity": [0, 0, -9.81],                          (optional, this default)
 ///      "base": {"type": "planar"},                        (optional; absent: fixed base)
-///      "constraint": {"type": "differential_drive"}}      (optional, needs a planar base)
+///      "constraint": {...}}                               (optional)
 ///
 /// A planar base puts q = (base_x, base_y, base_yaw, the URDF's joints): the root link's pose
-/// on the floor. `differential_drive`: the root link's origin cannot slip along the root
-/// link's y axis; η = (v, ω, the URDF's joint rates), v the forward speed along the root
-/// link's x axis, ω = ψ̇; k = 1 (`differential_drive(n, 0, 1, 2)`).
+/// on the floor. The constraints (docs/model-format.md and docs/theory.md give A, S, Ṡ):
+///
+/// - `{"type": "differential_drive"}` (planar base): the root link's origin cannot slip along
+///   the root link's y axis; η = (v, ω, the URDF's joint rates); k = 1. With the URDF's own
+///   base joints instead of a planar base: `"x"`, `"y"`, `"heading"` name them, with optional
+///   `"heading_sign"` (±1) and `"forward_offset"` [rad] as differential_drive takes them.
+/// - `{"type": "wheels", "left": J, "right": J, "radius": r}` (planar base): two drive
+///   wheels, continuous joints on the root link with horizontal lateral axes, roll without
+///   slipping, and the axle does not slip sideways; η = (φ̇_L, φ̇_R, other joint rates);
+///   k = 3 (rolling_wheels, its geometry read from the URDF).
+/// - `{"type": "bicycle", "steer": J, "wheelbase": L}` (planar base): rear axle at the root
+///   link's origin, the steered front wheel (vertical joint J) L ahead; neither axle slips
+///   sideways; η = (v, δ̇, other joint rates); k = 2.
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <variant>
+#include <vector>
 
-#include "../constraints/differential_drive.hpp"
+#include "../constraints/constraint.hpp"
 #include "json.hpp"
 #include "urdf.hpp"
 
 namespace nhdyn::io {
 
+/// A robot file's constraint: one of the built-in types a robot file can name.
+using robot_constraint = base_constraint;
+
 /// A robot loaded from a robot file: its tree and, when the file gives one, its constraint.
 struct robot_model {
   tree<double> model;
-  std::optional<differential_drive<double>> constraint;
+  std::optional<robot_constraint> constraint;
   std::string name;
+
+  /// Names of η's entries: the constraint's (`eta_names` of its type), or the joint names.
+  std::vector<std::string> eta_names() const {
+    const auto joints = model.joint_names();
+    if (!constraint) return joints;
+    return std::visit([&](const auto& c) { return c.eta_names(joints); }, *constraint);
+  }
+  /// k, the number of constraint rows (0 without a constraint).
+  int k() const {
+    return constraint ? std::visit([](const auto& c) { return c.k(); }, *constraint) : 0;
+  }
 };
+
+namespace detail {
+/// Index (q order) of the joint named by field `f` of a constraint object; errors list the
+/// movable joints.
+inline int named_joint(const json& c, const tree<double>& t, const place& at, std::string_view f) {
+  const std::string name = string_field(c[std::string(f)], at, f);
+  const auto joints = t.joint_names();
+  for (int i = 0; i < t.dof(); ++i)
+    if (joints[std::size_t(i)] == name) return i;
+  std::string known;
+  for (const auto& j : joints) known += (known.empty() ? "" : ", ") + j;
+  throw model_error(at.field(f) + "no movable joint named '" + name + "' (movable joints: " + known + ")");
+}
+
+/// A joint fixed to the root link (its parent is the planar base's moving body): its axis
+/// and origin in the root link's frame.
+struct joint_on_root {
+  Eigen::Vector3d axis, origin;
+};
+inline joint_on_root joint_on_root_link(const tree<double>& t, int j, const place& at, std::string_view f,
+                                        std::string_view what) {
+  const auto& b = t[j];
+  if (t.parent(j) != 2)
+    throw model_error(at.field(f) + "joint '" + b.joint_name + "' is not on the root link '" + t[2].name +
+                      "' (its parent is '" + (t.parent(j) < 0 ? t.root_name() : t[t.parent(j)].name) + "'): " +
+                      std::string(what) + " must be mounted on the base (directly or through fixed joints)");
+  if (b.joint != joint_type::revolute)
+    throw model_error(at.field(f) + "joint '" + b.joint_name + "' is prismatic; " + std::string(what) +
+                      " needs a revolute or continuous joint");
+  return {b.R_PJ * b.axis, b.p_PJ};
+}
+
+/// The sign (±1) of an axis that must lie along ±e (within 1e-3 per component; beyond
+/// 1e-9 a warning: a URDF's rpy written as 1.5708 is common and harmless).
+inline double axis_sign(const Eigen::Vector3d& a, int e, const std::string& where, std::string_view need,
+                        const urdf_options& opt) {
+  double off = 0;
+  for (int i = 0; i < 3; ++i)
+    if (i != e) off = std::max(off, std::abs(a(i)));
+  std::ostringstream os;
+  os << where << "the joint axis in the root link's frame is (" << a.x() << ", " << a.y() << ", " << a.z()
+     << "), not " << need;
+  if (off > 1e-3) throw model_error(os.str());
+  if (off > 1e-9) {
+    os << " to " << off << "; taken as exact";
+    if (opt.warn) opt.warn(os.str());
+    else std::cerr << "nhdyn: warning: " << os.str() << '\n';
+  }
+  return a(e) > 0 ? 1.0 : -1.0;
+}
+
+inline robot_constraint read_robot_constraint(const json& c, const tree<double>& t, const place& top,
+                                              const urdf_options& opt) {
+  const place at{top.prefix + ", constraint"};
+  const std::string known = "(known: differential_drive, wheels, bicycle)";
+  if (!c.is_object() || !c.contains("type") || !c["type"].is_string())
+    throw model_error(top.field("constraint") + "expected an object with a \"type\" " + known);
+  const std::string type = c["type"].get<std::string>();
+  const int n = t.dof();
+  const auto needs_planar = [&] {
+    if (!opt.planar_base)
+      throw model_error(top.field("constraint") + "a '" + type + "' constraint needs a planar base (\"base\": {\"type\": \"planar\"})");
+  };
+  try {
+    if (type == "differential_drive") {
+      check_keys(c, {"type", "x", "y", "heading", "heading_sign", "forward_offset"}, {}, at.prefix + ", ", "the constraint");
+      const bool named = c.contains("x") || c.contains("y") || c.contains("heading");
+      if (!named) {
+        needs_planar();
+        if (c.contains("heading_sign") || c.contains("forward_offset"))
+          throw model_error(at.prefix + ": heading_sign and forward_offset go with named x, y, heading joints");
+        return differential_drive<double>(n, 0, 1, 2);
+      }
+      if (opt.planar_base)
+        throw model_error(at.prefix + ": x, y, heading name the URDF's own base joints; with a planar base they are base_x, base_y, base_yaw (leave them out)");
+      check_keys(c, {"type", "x", "y", "heading", "heading_sign", "forward_offset"}, {"x", "y", "heading"}, at.prefix + ", ",
+                 "the constraint");
+      const double sign = c.contains("heading_sign") ? number(c["heading_sign"], at, "heading_sign") : 1.0;
+      const double offset = c.contains("forward_offset") ? number(c["forward_offset"], at, "forward_offset") : 0.0;
+      return differential_drive<double>(n, named_joint(c, t, at, "x"), named_joint(c, t, at, "y"),
+                                        named_joint(c, t, at, "heading"), offset, sign);
+    }
+    if (type == "wheels") {
+      check_keys(c, {"type", "left", "right", "radius"}, {"left", "right", "radius"}, at.prefix + ", ", "the constraint");
+      needs_planar();
+      const double r = number(c["radius"], at, "radius");
+      if (!(r > 0)) throw model_error(at.field("radius") + "the wheel radius must be positive, not " + format_number(r));
+      const int l = named_joint(c, t, at, "left"), rt = named_joint(c, t, at, "right");
+      if (l == rt) throw model_error(at.prefix + ": left and right name the same joint '" + t[l].joint_name + "'");
+      const auto L = joint_on_root_link(t, l, at, "left", "a drive wheel");
+      const auto R = joint_on_root_link(t, rt, at, "right", "a drive wheel");
+      const double sl = axis_sign(L.axis, 1, at.field("left"), "horizontal and lateral (±y)", opt);
+      const double sr = axis_sign(R.axis, 1, at.field("right"), "horizontal and lateral (±y)", opt);
+      if (std::abs(L.origin.x() - R.origin.x()) > 1e-6) {
+        std::ostringstream os;
+        os << at.prefix << ": the wheels are not on one axle: their centres are at x = " << L.origin.x() << " and "
+           << R.origin.x() << " m in the root link's frame";
+        throw model_error(os.str());
+      }
+      if (!(std::abs(L.origin.y() - R.origin.y()) > 1e-9))
+        throw model_error(at.prefix + ": the two wheel centres have the same lateral position (zero track)");
+      return rolling_wheels<double>(n, l, rt, r, L.origin.y(), R.origin.y(), 0.5 * (L.origin.x() + R.origin.x()), sl, sr);
+    }
+    if (type == "bicycle") {
+      check_keys(c, {"type", "steer", "wheelbase"}, {"steer", "wheelbase"}, at.prefix + ", ", "the constraint");
+      needs_planar();
+      const double L = number(c["wheelbase"], at, "wheelbase");
+      if (!(L > 0)) throw model_error(at.field("wheelbase") + "must be positive, not " + format_number(L));
+      const int s = named_joint(c, t, at, "steer");
+      const auto J = joint_on_root_link(t, s, at, "steer", "the steering joint");
+      const double sign = axis_sign(J.axis, 2, at.field("steer"), "vertical (±z)", opt);
+      if (std::abs(J.origin.x() - L) > 1e-3 || std::abs(J.origin.y()) > 1e-3) {
+        std::ostringstream os;
+        os << at.prefix << ": the steering joint '" << t[s].joint_name << "' is at (" << J.origin.x() << ", "
+           << J.origin.y() << ") m in the root link's frame, not on the front axle at (" << L
+           << ", 0); the model puts the front wheel at (wheelbase, 0)";
+        if (opt.warn) opt.warn(os.str());
+        else std::cerr << "nhdyn: warning: " << os.str() << '\n';
+      }
+      return bicycle<double>(n, s, L, sign);
+    }
+  } catch (const model_error& e) {
+    const std::string what = e.what();
+    if (what.rfind(at.prefix, 0) == 0 || what.rfind(top.prefix, 0) == 0) throw;
+    throw model_error(at.prefix + ": " + what);
+  }
+  throw model_error(at.field("type") + "unknown constraint type '" + type + "' " + known);
+}
+}  // namespace detail
 
 /// The robot file's text; `path` locates the URDF (relative paths from its folder) and names
 /// the file in messages.
@@ -55,18 +211,7 @@ inline robot_model parse_robot_file(const std::string& text, const std::string& 
   }
   robot_model out{load_urdf(urdf_path.string(), opt), std::nullopt, ""};
   out.name = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : out.model.name();
-  if (j.contains("constraint")) {
-    const json& c = j["constraint"];
-    if (!c.is_object() || !c.contains("type") || !c["type"].is_string())
-      throw model_error(top.field("constraint") + "expected {\"type\": \"differential_drive\"}");
-    detail::check_keys(c, {"type"}, {"type"}, top.field("constraint"), "the constraint");
-    const std::string type = c["type"].get<std::string>();
-    if (type != "differential_drive")
-      throw model_error(top.field("constraint") + "unknown constraint type '" + type + "' (known: differential_drive)");
-    if (!opt.planar_base)
-      throw model_error(top.field("constraint") + "a differential drive needs a planar base (\"base\": {\"type\": \"planar\"})");
-    out.constraint = differential_drive<double>(out.model.dof(), 0, 1, 2);
-  }
+  if (j.contains("constraint")) out.constraint = detail::read_robot_constraint(j["constraint"], out.model, top, opt);
   return out;
 }
 
