@@ -3,6 +3,7 @@
 #include "kdl_reference.hpp"
 
 #include <kdl/chain.hpp>
+#include <kdl/chainfdsolver_recursive_newton_euler.hpp>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/frames.hpp>
 #include <kdl/jntarray.hpp>
@@ -19,7 +20,8 @@ namespace nhdyn_bench::kdl {
 struct solver {
   KDL::Chain chain;
   std::unique_ptr<KDL::ChainIdSolver_RNE> id;
-  KDL::JntArray q, qd, qdd, tau;
+  std::unique_ptr<KDL::ChainFdSolver_RNE> fd;
+  KDL::JntArray q, qd, qdd, tau, fd_tau, fd_qdd;
   KDL::Wrenches f_ext;
 };
 
@@ -36,7 +38,8 @@ solver* make(const dh_row* rows, int n, const double g[3]) {
     s->chain.addSegment(KDL::Segment(j, KDL::Frame::DH(r.a, r.alpha, r.d, r.theta), rbi));
   }
   s->id = std::make_unique<KDL::ChainIdSolver_RNE>(s->chain, KDL::Vector(g[0], g[1], g[2]));
-  s->q = s->qd = s->qdd = s->tau = KDL::JntArray(static_cast<unsigned>(n));
+  s->fd = std::make_unique<KDL::ChainFdSolver_RNE>(s->chain, KDL::Vector(g[0], g[1], g[2]));
+  s->q = s->qd = s->qdd = s->tau = s->fd_tau = s->fd_qdd = KDL::JntArray(static_cast<unsigned>(n));
   s->f_ext.assign(static_cast<std::size_t>(n), KDL::Wrench::Zero());
   return s;
 }
@@ -55,6 +58,20 @@ int run(solver* s) { return s->id->CartToJnt(s->q, s->qd, s->qdd, s->f_ext, s->t
 
 void torques(const solver* s, double* tau) {
   for (unsigned i = 0; i < s->tau.rows(); ++i) tau[i] = s->tau(i);
+}
+
+void set_fd_state(solver* s, const double* q, const double* qd, const double* tau) {
+  for (unsigned i = 0; i < s->q.rows(); ++i) {
+    s->q(i) = q[i];
+    s->qd(i) = qd[i];
+    s->fd_tau(i) = tau[i];
+  }
+}
+
+int run_fd(solver* s) { return s->fd->CartToJnt(s->q, s->qd, s->fd_tau, s->f_ext, s->fd_qdd); }
+
+void accelerations(const solver* s, double* qdd) {
+  for (unsigned i = 0; i < s->fd_qdd.rows(); ++i) qdd[i] = s->fd_qdd(i);
 }
 
 struct tree_solver {

@@ -1,6 +1,6 @@
 #pragma once
 /// \file bench/kdl_reference.hpp
-/// Orocos KDL's ChainIdSolver_RNE behind a plain-C++ boundary: only doubles, ints and an
+/// Orocos KDL's ChainIdSolver_RNE, ChainFdSolver_RNE and TreeIdSolver_RNE behind a plain-C++ boundary: only doubles, ints and an
 /// opaque handle cross it. kdl_reference.cpp is compiled with baseline x86-64 flags (as
 /// Debian's KDL is), the rest of the benchmark with -march=native, so no Eigen object may
 /// be shared between the two (their alignment ABI differs).
@@ -28,6 +28,11 @@ void set_state(solver* s, const double* q, const double* qd, const double* qdd);
 int run(solver* s);
 /// Copies the last result out.
 void torques(const solver* s, double* tau);
+/// KDL's ChainFdSolver_RNE (M by n RNE calls, then a Cholesky solve) on the same chain:
+/// stores (q, q̇, τ); one CartToJnt call (timed); copies q̈ out.
+void set_fd_state(solver* s, const double* q, const double* qd, const double* tau);
+int run_fd(solver* s);
+void accelerations(const solver* s, double* qdd);
 
 /// One body of a kinematic tree (nhdyn's tree<double> with identity body offsets, as URDF
 /// gives): its parent (−1: the root), the joint frame in the parent's (R row-major, p), the

@@ -8,6 +8,8 @@
 ///   nh_inertia/<model>/{crba, rne_columns}      M_η = SᵀMS two ways
 ///   rne/<tree>/{nhdyn, reference, kdl}          rne on kinematic trees (the kernel, the plain
 ///   crba/<tree>/{nhdyn, reference}               spatial-algebra reference, KDL's tree solver);
+///   fd/<model>/{aba, crba_ldlt, kdl}            holonomic forward dynamics: the articulated-
+///                                               body algorithm, CRBA + LDLᵀ, KDL's ChainFdSolver_RNE
 ///                                               mass matrix by the kernel and the reference
 ///   nh_id/<robot>/{rne, lagrange}               a robot file's nonholonomic inverse dynamics
 ///   nh_pair/<robot>/run_time                     (robot: mobile_manipulator_{ddrive, wheels,
@@ -25,6 +27,7 @@
 #include <cstdlib>
 #include <memory>
 
+#include <nhdyn/dynamics/aba.hpp>
 #include <nhdyn/dynamics/reference.hpp>
 #include <nhdyn/dynamics/tree.hpp>
 #ifdef NHDYN_BENCH_URDF
@@ -153,6 +156,36 @@ void register_rne(const std::string& model, const chain<double>& cd, bool with_k
   kdl::torques(k.get(), tau_k.data());
   agree(tau_d, tau_k, 1e-10, "rne/" + model + ": nhdyn vs KDL ChainIdSolver_RNE");
   add("rne/" + model + "/kdl", [k]() { benchmark::DoNotOptimize(kdl::run(k.get())); });
+}
+
+// ------------------------------------------------- issue 15: forward dynamics, ABA vs CRBA vs KDL
+
+void register_fd(const std::string& model, const chain<double>& cd) {
+  const int n = cd.dof();
+  const state s = random_state(n, 23);
+  const Eigen::VectorXd tau = s.qdd;  // any torques
+  auto ab = nhdyn::aba(nhdyn::as_tree(cd));
+  auto cr = nhdyn::forward_dynamics(cd);
+  const Eigen::VectorXd qdd = cr(s.q, s.qd, tau);
+  agree(ab(s.q, s.qd, tau), qdd, 1e-9, "fd/" + model + ": aba vs CRBA + LDLT");
+  const auto rows = kdl_rows(cd);
+  std::shared_ptr<kdl::solver> k(kdl::make(rows.data(), n, cd.gravity().data()), kdl::destroy);
+  kdl::set_fd_state(k.get(), s.q.data(), s.qd.data(), tau.data());
+  if (kdl::run_fd(k.get()) != 0) fail("fd/" + model + ": KDL's ChainFdSolver_RNE returned an error");
+  Eigen::VectorXd qdd_k(n);
+  kdl::accelerations(k.get(), qdd_k.data());
+  agree(qdd_k, qdd, 1e-8, "fd/" + model + ": KDL ChainFdSolver_RNE vs CRBA + LDLT");
+  add("fd/" + model + "/aba", [ab, s, tau]() mutable {
+    opaque(s.q), opaque(s.qd), opaque(tau);
+    auto r = ab(s.q, s.qd, tau);
+    benchmark::DoNotOptimize(r);
+  });
+  add("fd/" + model + "/crba_ldlt", [cr, s, tau]() mutable {
+    opaque(s.q), opaque(s.qd), opaque(tau);
+    auto r = cr(s.q, s.qd, tau);
+    benchmark::DoNotOptimize(r);
+  });
+  add("fd/" + model + "/kdl", [k]() { benchmark::DoNotOptimize(kdl::run_fd(k.get())); });
 }
 
 // ------------------------------------------------- issue 3: nonholonomic id vs Lagrange
@@ -462,6 +495,10 @@ int main(int argc, char** argv) {
   register_rne<24>("rev24", random_chain(24));
   register_rne<48>("rev48", random_chain(48));
   register_rne<96>("rev96", random_chain(96));
+
+  register_fd("paper5", p5);
+  register_fd("puma560", nhdyn::presets::puma560<double>().dynamic_size());
+  for (int n : {6, 12, 24, 48, 96}) register_fd("rev" + std::to_string(n), random_chain(n));
 
   register_nh<5>("paper5", p5);
   register_rne<5>("ddrive_arm2", ddrive_arm(2), false);

@@ -319,12 +319,33 @@ TEST_CASE("ill-conditioning: tiny masses make M_eta near singular; the caller se
       CHECK(fd(q, eta, tau).allFinite());
     }
   }
-  // Past 1/eps the forward dynamics refuses, naming the matrix and the ratio.
+  // κ past 1/ε, yet the problem is benign once M_η is scaled by its diagonal (the arm's rows
+  // are tiny, not dependent): the forward dynamics answers, as long double does.
   p.mass_factor = {1, 1, 1, 1e-17, 1e-17};
   const auto r = presets::paper5<double>(p);
   const auto fd = nh_forward_dynamics(r.chain, r.constraint);
   CHECK(fd.reduced_inertia_condition(q) > 1e16);
-  CHECK_THAT(message_of<numerical_error>([&] { fd(q, eta, tau); }), Contains("M_η = SᵀMS is numerically singular"));
+  presets::paper5_parameters<long double> pl;
+  pl.mass_factor = {1, 1, 1, 1e-17L, 1e-17L};
+  const auto rl = presets::paper5<long double>(pl);
+  const VectorXd a = fd(q, eta, tau);
+  const VectorXd b = nh_forward_dynamics(rl.chain, rl.constraint)(q.cast<long double>().eval(), eta.cast<long double>().eval(),
+                                                                  tau.cast<long double>().eval())
+                         .cast<double>();
+  CHECK((a - b).lpNorm<Eigen::Infinity>() <= 1e-12 * b.lpNorm<Eigen::Infinity>());
+  // Near-dependent rows stay near-dependent after scaling: scaled pivot 1e-12, refused at a
+  // threshold of 1e10 (the default is 1/ε), naming the matrix and the scaled pivot; the same
+  // matrix with its rows scaled by 1e-8 is the same problem and gets the same verdict.
+  Eigen::Matrix4d Ms = Eigen::Matrix4d::Identity();
+  Ms.block<2, 2>(2, 2) << 1.0, 1.0 - 5e-13, 1.0 - 5e-13, 1.0;
+  CHECK_THAT(message_of<numerical_error>([&] { ldlt_factor<double, 4>(Ms, "M_η = SᵀMS", 1e10); }),
+             Contains("M_η = SᵀMS is numerically singular") && Contains("scaled pivot 3"));
+  const Eigen::Vector4d d(1, 1e-8, 1, 1e-8);
+  const Eigen::Matrix4d Ms_scaled = d.asDiagonal() * Ms * d.asDiagonal();
+  const Eigen::Matrix4d I_scaled = d.asDiagonal() * Eigen::Matrix4d::Identity() * d.asDiagonal();  // κ = 1e16
+  const auto factor = [](const Eigen::Matrix4d& A) { return ldlt_factor<double, 4>(A, "M", 1e10); };
+  CHECK_THROWS_AS(factor(Ms_scaled), numerical_error);
+  CHECK_NOTHROW(factor(I_scaled));
   // A massless tip makes M exactly singular: holonomic forward dynamics says so.
   auto L = good_link();
   L.mass = 0;

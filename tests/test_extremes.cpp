@@ -269,7 +269,12 @@ TEST_CASE("extremes: masses from 1e-9 to 1e6 kg in one chain") {
                              .mass_matrix_condition(state<double, double>(16, 1.0, 1));
     if (print()) std::printf("| (κ(M) = %.1e) | | | |\n", kappa);
     CHECK(kappa > 1e13);
-    CHECK_THROWS_AS(measure<float>(("16-joint fd, masses " + tag).c_str(), fd, 1.0), numerical_error);
+    // float: the heavy-base chain is benign once scaled (scaled κ ≈ 7) and is answered to a
+    // few ulps; the light-base one (scaled κ ≈ 1.3e13 > 1/ε of float) is refused.
+    if (heavy_base)
+      measure<float>(("16-joint fd, masses " + tag).c_str(), fd, 100 * u<float>());
+    else
+      CHECK_THROWS_AS(measure<float>(("16-joint fd, masses " + tag).c_str(), fd, 1.0), numerical_error);
     // Measured: heavy base ~2u (scaled κ ≈ 7); light base ~1e12·u (scaled κ ≈ 1.3e13).
     const double k = heavy_base ? 100 : 3e13;
     measure<double>(("16-joint fd, masses " + tag).c_str(), fd, k * u<double>());

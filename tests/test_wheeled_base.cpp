@@ -6,7 +6,7 @@
 /// - the projected Euler–Lagrange equations (tests/reference/lagrangian.hpp, long double):
 ///   τ = (SᵀE)⁻¹ Sᵀ (M q̈ + C q̇ + g), q̇ = S η, q̈ = S η̇ + Ṡ η, λ from v − Eτ = Aᵀλ;
 /// - power: τᵀη = dE/dt (the reference's exact energy rate) and q̇ᵀ(v − Eτ) = 0;
-/// - an unforced 10 s simulation: |A q̇| at rounding level, energy kept;
+/// - an unforced 10 s simulation (RK4, h = 5 ms): |A q̇| at rounding level, energy kept;
 /// - rolling checked by kinematics: the wheel's contact point has zero velocity;
 /// - paper5.json (URDF + robot file) = the paper5 preset to 1e-12;
 /// - a user constraint coupling a wheel and an arm joint on the tree.
@@ -270,9 +270,9 @@ TEST_CASE("wheeled robots: an unforced 10 s motion keeps A q_dot = 0 and the ene
           VectorXd x(n + m);
           x << q, eta;
           const double E0 = nhdyn_ref::energy<double>(ref, VectorXd(x.head(n)), VectorXd(apply_S(c, x.head(n), x.tail(m))));
-          const double h = 2e-3;
+          const double h = 5e-3;
           double worst = 0, speed = 0;
-          for (int step = 0; step < 5000; ++step) {  // 10 s, RK4
+          for (int step = 0; step < 2000; ++step) {  // 10 s, RK4
             const VectorXd k1 = f(x), k2 = f(x + h / 2 * k1), k3 = f(x + h / 2 * k2), k4 = f(x + h * k3);
             x += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
             const VectorXd qd = apply_S(c, x.head(n), x.tail(m));
@@ -283,6 +283,7 @@ TEST_CASE("wheeled robots: an unforced 10 s motion keeps A q_dot = 0 and the ene
           const double E1 = nhdyn_ref::energy<double>(ref, VectorXd(x.head(n)), qd);
           CHECK(x.allFinite());
           CHECK(worst <= 1e-14 * (1 + speed));
+          INFO("energy " << E0 << " J -> " << E1 << " J");
           CHECK(std::abs(E1 - E0) <= 1e-6 * (1 + std::abs(E0)));
           CHECK((x.head(2) - q.head(2)).norm() > 0.5);  // it did travel
         },

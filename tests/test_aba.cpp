@@ -1,0 +1,155 @@
+/// The articulated-body forward dynamics (dynamics/aba.hpp) against independent references:
+/// CRBA + LDLᵀ (the mass matrix route), the inverse dynamics it must invert, ∂q̈/∂τ = M⁻¹ by
+/// dual numbers, interval enclosure, and 50-digit CRBA + LDLᵀ on chains whose masses span
+/// 1e-9 to 1e6 kg (both routes, with the scaled singularity test of detail/ldlt.hpp).
+#include <catch2/catch.hpp>
+
+#include <Eigen/Cholesky>
+#include <nhdyn/dynamics/aba.hpp>
+#include <nhdyn/dynamics/tree.hpp>
+#include <nhdyn/nhdyn.hpp>
+#include <nhdyn/scalar/interval.hpp>
+#include <nhdyn/scalar/multiprecision.hpp>
+#include <limits>
+#include <random>
+
+#include "reference/random_tree.hpp"
+
+using namespace nhdyn;
+using Eigen::VectorXd;
+
+namespace {
+VectorXd random_vec(std::mt19937_64& rng, int n, double r) {
+  return VectorXd::NullaryExpr(n, [&] { return nhdyn_ref::uniform(rng, -r, r); });
+}
+double rel(const VectorXd& a, const VectorXd& b) { return (a - b).lpNorm<Eigen::Infinity>() / std::max(1.0, b.lpNorm<Eigen::Infinity>()); }
+
+/// A chain (no branches) of n bodies whose masses span 1e-9…1e6 kg: `order` 0 heavy at the
+/// base, 1 light at the base, 2 shuffled; rotational inertias scale with each mass.
+tree<double> mass_span_chain(std::mt19937_64& rng, int n, int order) {
+  auto t = nhdyn_ref::random_tree(rng, n, 0.0, false);
+  std::vector<body<double>> B(t.begin(), t.end());
+  std::vector<double> e(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) e[std::size_t(i)] = 6.0 - 15.0 * i / (n - 1);  // log10 m: 6 … −9
+  if (order == 1) std::reverse(e.begin(), e.end());
+  if (order == 2) std::shuffle(e.begin(), e.end(), rng);
+  for (int i = 0; i < n; ++i) {
+    auto& b = B[std::size_t(i)];
+    b.mass = std::pow(10.0, e[std::size_t(i)]);
+    b.inertia = nhdyn_ref::random_inertia(rng, b.mass);
+  }
+  return tree<double>(std::move(B), t.gravity(), "mass span");
+}
+}  // namespace
+
+TEST_CASE("aba = CRBA + LDLT forward dynamics and inverts rne, on random trees of 1-40 bodies", "[aba]") {
+  std::mt19937_64 rng(15);
+  for (int n : {1, 2, 3, 5, 8, 13, 21, 40}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      const auto t = nhdyn_ref::random_tree(rng, n, 0.4, trial % 2 == 0);
+      const VectorXd q = random_vec(rng, n, 2), qd = random_vec(rng, n, 2), tau = random_vec(rng, n, 5);
+      const VectorXd a = aba(t)(q, qd, tau);
+      const VectorXd b = forward_dynamics(t)(q, qd, tau);
+      INFO("n = " << n);
+      CHECK(rel(a, b) <= 1e-10);
+      CHECK(rel(VectorXd(rne(t)(q, qd, a)), tau) <= 1e-10);
+      // the unchecked reference form gives the same numbers
+      CHECK(rel(reference::aba<double>(t, q, qd, tau), a) == 0.0);
+    }
+  }
+}
+
+TEST_CASE("aba on other scalars: float, long double, duals (dq̈/dτ = M⁻¹) and intervals (enclosure)", "[aba]") {
+  std::mt19937_64 rng(16);
+  const auto t = nhdyn_ref::random_tree(rng, 9, 0.4, true);
+  const int n = t.dof();
+  const VectorXd q = random_vec(rng, n, 2), qd = random_vec(rng, n, 2), tau = random_vec(rng, n, 5);
+  const VectorXd a = aba(t)(q, qd, tau);
+  const auto af = aba(t.cast<float>())(q.cast<float>().eval(), qd.cast<float>().eval(), tau.cast<float>().eval());
+  CHECK(rel(af.cast<double>(), a) <= 1e-3);
+  const auto al = aba(t.cast<long double>())(q.cast<long double>().eval(), qd.cast<long double>().eval(),
+                                              tau.cast<long double>().eval());
+  CHECK(rel(al.cast<double>(), a) <= 1e-11);
+  // ∂q̈/∂τ_j = column j of M⁻¹ (CRBA), by a dual in τ_j
+  const Eigen::MatrixXd Minv = mass_matrix(t)(q).inverse();
+  using D = dual<double, 1>;
+  for (int j = 0; j < n; ++j) {
+    vecN<D, dynamic> td = tau.cast<D>();
+    td(j) = D(tau(j), {1.0});
+    const auto ad = aba(t)(q, qd, td);
+    VectorXd col(n), val(n);
+    for (int i = 0; i < n; ++i) {
+      col(i) = ad(i).derivative(0);
+      val(i) = ad(i).value();
+    }
+    CHECK(rel(val, a) <= 1e-15);  // the dual's value part: the double arithmetic, reordered
+    CHECK(rel(col, Minv.col(j)) <= 1e-10);
+  }
+  // an interval evaluation at the point state encloses the double result
+  const auto ai = aba(t)(q.cast<interval>().eval(), qd.cast<interval>().eval(), tau.cast<interval>().eval());
+  for (int i = 0; i < n; ++i) {
+    CHECK(ai(i).lower() <= a(i));
+    CHECK(ai(i).upper() >= a(i));
+  }
+}
+
+TEST_CASE("chains whose masses span 1e-9 to 1e6 kg: aba and CRBA + LDLT against a 50-digit reference", "[aba]") {
+  // What is determined: the error of any method in double is at least ≈ κ_s·ε, κ_s the
+  // condition number of M scaled by its diagonal (LDLᵀ is invariant under that scaling, and
+  // the exact M rounded once already costs that much, docs/accuracy.md). Heavy base → light
+  // tip and shuffled masses have κ_s ≤ 1e7 here: both methods must give 1e-6. Light base →
+  // heavy tip has κ_s up to 1e15: a 1e-9 kg link carrying 1e6 kg, ill-conditioned in itself.
+  std::mt19937_64 rng(17);
+  double worst_aba_ok = 0, worst_crba_ok = 0;
+  for (int n : {4, 8, 16, 32}) {
+    for (int order = 0; order < 3; ++order) {
+      for (int trial = 0; trial < 3; ++trial) {
+        const auto t = mass_span_chain(rng, n, order);
+        const VectorXd q = random_vec(rng, n, 2), qd = random_vec(rng, n, 1), tau = random_vec(rng, n, 1);
+        // the reference: CRBA + LDLᵀ in 50 digits (no ABA code), from the same double model
+        const vecN<mp50, dynamic> qm = q.cast<mp50>(), qdm = qd.cast<mp50>(), taum = tau.cast<mp50>();
+        const auto Mm = reference::crba<mp50>(t, qm);
+        const auto hm = reference::rne<mp50>(t, qm, qdm, vecN<mp50, dynamic>(vecN<mp50, dynamic>::Zero(n)));
+        const vecN<mp50, dynamic> ref_m = Mm.ldlt().solve(vecN<mp50, dynamic>(taum - hm));
+        VectorXd ref(n);
+        for (int i = 0; i < n; ++i) ref(i) = static_cast<double>(ref_m(i));
+        const Eigen::MatrixXd M = mass_matrix(t)(q);
+        const VectorXd s = M.diagonal().cwiseSqrt().cwiseInverse();
+        const double kappa_s = condition_number(Eigen::MatrixXd(s.asDiagonal() * M * s.asDiagonal()));
+        const double eps = std::numeric_limits<double>::epsilon();
+        const double allowed = std::max(1e-6, 1e3 * kappa_s * eps);
+        const auto err = [&](const VectorXd& x) { return (x - ref).lpNorm<Eigen::Infinity>() / ref.lpNorm<Eigen::Infinity>(); };
+        INFO("n = " << n << ", order " << order << ", scaled condition " << kappa_s);
+        const double ea = err(aba(t)(q, qd, tau));
+        CHECK(ea <= allowed);
+        if (kappa_s * eps <= 1e-9) {
+          CHECK(ea <= 1e-6);
+          worst_aba_ok = std::max(worst_aba_ok, ea);
+        }
+        // CRBA + LDLᵀ with the scaled test: answers unless scaled-singular, with the same bound
+        if (kappa_s < 0.01 / eps) {
+          const double ec = err(forward_dynamics(t)(q, qd, tau));
+          CHECK(ec <= allowed);
+          if (kappa_s * eps <= 1e-9) worst_crba_ok = std::max(worst_crba_ok, ec);
+        }
+      }
+    }
+  }
+  CHECK(worst_aba_ok <= 1e-6);
+  CHECK(worst_crba_ok <= 1e-6);
+}
+
+TEST_CASE("aba refuses only a truly singular or non-finite problem, and says which joint", "[aba]") {
+  std::mt19937_64 rng(18);
+  auto t = nhdyn_ref::random_tree(rng, 4, 0.0, false);
+  std::vector<body<double>> B(t.begin(), t.end());
+  B[3].mass = 0;  // a massless, inertia-free leaf: nothing moves with joint 3
+  B[3].inertia.setZero();
+  const tree<double> s(std::move(B), t.gravity(), "singular");
+  const VectorXd z = VectorXd::Zero(4);
+  CHECK_THROWS_WITH(aba(s)(z, z, z), Catch::Matchers::Contains("joint3") && Catch::Matchers::Contains("singular"));
+  VectorXd bad = z;
+  bad(2) = std::nan("");
+  CHECK_THROWS_WITH(aba(t)(bad, z, z), Catch::Matchers::Contains("q"));
+  CHECK_THROWS_WITH(aba(t)(z, VectorXd::Zero(3), z), Catch::Matchers::Contains("qd"));
+}
