@@ -22,53 +22,39 @@ constexpr std::string_view usage = R"(nhdyn fd --model MODEL [--strict]
   --strict: a URDF inertia that is not physically valid is an error instead of a warning.
 )";
 
+/// Lines of a model with a constraint: (q, η, τ) -> η̇.
+template <class Model, class C>
+int constrained(const Model& model, const C& c, const std::string& name) {
+  const auto fd = nhdyn::nh_forward_dynamics(model, c);
+  return run_lines(std::cin, std::cout, [&](const line& l) {
+    if (l.has("qd"))
+      throw nhdyn::input_error("model '" + name + "' has a constraint: lines are {\"q\", \"eta\", \"tau\"} (eta and tau have " +
+                               std::to_string(c.m()) + " entries)");
+    l.expect_keys({"q", "eta", "tau"});
+    const Eigen::VectorXd eta_dot = fd(l.vector("q", c.dof()), l.vector("eta", c.m()), l.vector("tau", c.m()));
+    return ordered_json{{"eta_dot", to_json(eta_dot)}};
+  });
+}
+/// Lines of a holonomic model: (q, q̇, τ) -> q̈.
+template <class Model>
+int holonomic(const Model& model, const std::string& name) {
+  const auto fd = nhdyn::forward_dynamics(model);
+  const int n = model.dof();
+  return run_lines(std::cin, std::cout, [&](const line& l) {
+    if (l.has("eta"))
+      throw nhdyn::input_error("model '" + name + "' has no constraint: lines are {\"q\", \"qd\", \"tau\"}");
+    l.expect_keys({"q", "qd", "tau"});
+    const Eigen::VectorXd qdd = fd(l.vector("q", n), l.vector("qd", n), l.vector("tau", n));
+    return ordered_json{{"qdd", to_json(qdd)}};
+  });
+}
+
 int run(const std::vector<std::string>& args) {
   const auto any = start_any_model_command(args, usage);
   if (!any) return 0;  // --help
-  if (any->tree && any->tree_constraint)  // a robot file: (q, η, τ) -> η̇
-    return std::visit(
-        [&](const auto& c) {
-          const auto fd = nhdyn::nh_forward_dynamics(*any->tree, c);
-          return run_lines(std::cin, std::cout, [&](const line& l) {
-            l.expect_keys({"q", "eta", "tau"});
-            const Eigen::VectorXd eta_dot = fd(l.vector("q", c.dof()), l.vector("eta", c.m()), l.vector("tau", c.m()));
-            return ordered_json{{"eta_dot", to_json(eta_dot)}};
-          });
-        },
-        *any->tree_constraint);
-  if (any->tree) {
-    const auto& t = *any->tree;
-    const auto fd = nhdyn::forward_dynamics(t);
-    const int n = t.dof();
-    return run_lines(std::cin, std::cout, [&](const line& l) {
-      l.expect_keys({"q", "qd", "tau"});
-      const Eigen::VectorXd qdd = fd(l.vector("q", n), l.vector("qd", n), l.vector("tau", n));
-      return ordered_json{{"qdd", to_json(qdd)}};
-    });
-  }
-  const auto& m = *any->dh;
-  const auto& ch = m.chain;
-  const int n = ch.dof();
-  if (!m.constraint) {
-    const auto fd = nhdyn::forward_dynamics(ch);
-    return run_lines(std::cin, std::cout, [&](const line& l) {
-      if (l.has("eta"))
-        throw nhdyn::input_error("model '" + ch.name() + "' has no constraint: lines are {\"q\", \"qd\", \"tau\"}");
-      l.expect_keys({"q", "qd", "tau"});
-      const Eigen::VectorXd qdd = fd(l.vector("q", n), l.vector("qd", n), l.vector("tau", n));
-      return ordered_json{{"qdd", to_json(qdd)}};
-    });
-  }
-  const auto& c = *m.constraint;
-  const auto fd = nhdyn::nh_forward_dynamics(ch, c);
-  return run_lines(std::cin, std::cout, [&](const line& l) {
-    if (l.has("qd"))
-      throw nhdyn::input_error("model '" + ch.name() + "' has a constraint: lines are {\"q\", \"eta\", \"tau\"} (eta and tau have " +
-                               std::to_string(c.m()) + " entries)");
-    l.expect_keys({"q", "eta", "tau"});
-    const Eigen::VectorXd eta_dot = fd(l.vector("q", n), l.vector("eta", c.m()), l.vector("tau", c.m()));
-    return ordered_json{{"eta_dot", to_json(eta_dot)}};
-  });
+  return dispatch(
+      *any, [&](const auto& model, const auto& c) { return constrained(model, c, any->name()); },
+      [&](const auto& model) { return holonomic(model, any->name()); });
 }
 }  // namespace
 

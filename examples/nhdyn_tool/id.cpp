@@ -23,57 +23,39 @@ constexpr std::string_view usage = R"(nhdyn id --model MODEL [--strict]
   --strict: a URDF inertia that is not physically valid is an error instead of a warning.
 )";
 
-ordered_json holonomic(const nhdyn::chain<double>& ch, const line& l) {
-  l.expect_keys({"q", "qd", "qdd"});
-  const int n = ch.dof();
-  const Eigen::VectorXd tau = nhdyn::rne(ch)(l.vector("q", n), l.vector("qd", n), l.vector("qdd", n));
-  return {{"tau", to_json(tau)}};
+/// Lines of a model with a constraint: (q, η, η̇) -> (τ, λ).
+template <class Model, class C>
+int constrained(const Model& model, const C& c, const std::string& name) {
+  const auto id = nhdyn::inverse_dynamics_with_forces(model, c);
+  return run_lines(std::cin, std::cout, [&](const line& l) {
+    if (l.has("qd") || l.has("qdd"))
+      throw nhdyn::input_error("model '" + name + "' has a constraint: lines are {\"q\", \"eta\", \"eta_dot\"} (eta has " +
+                               std::to_string(c.m()) + " entries)");
+    l.expect_keys({"q", "eta", "eta_dot"});
+    const auto f = id(l.vector("q", c.dof()), l.vector("eta", c.m()), l.vector("eta_dot", c.m()));
+    return ordered_json{{"tau", to_json(Eigen::VectorXd(f.tau))}, {"lambda", to_json(Eigen::VectorXd(f.lambda))}};
+  });
+}
+/// Lines of a holonomic model: (q, q̇, q̈) -> τ.
+template <class Model>
+int holonomic(const Model& model, const std::string& name) {
+  const auto id = nhdyn::rne(model);
+  const int n = model.dof();
+  return run_lines(std::cin, std::cout, [&](const line& l) {
+    if (l.has("eta") || l.has("eta_dot"))
+      throw nhdyn::input_error("model '" + name + "' has no constraint: lines are {\"q\", \"qd\", \"qdd\"}");
+    l.expect_keys({"q", "qd", "qdd"});
+    const Eigen::VectorXd tau = id(l.vector("q", n), l.vector("qd", n), l.vector("qdd", n));
+    return ordered_json{{"tau", to_json(tau)}};
+  });
 }
 
 int run(const std::vector<std::string>& args) {
   const auto any = start_any_model_command(args, usage);
   if (!any) return 0;  // --help
-  if (any->tree && any->tree_constraint)  // a robot file: (q, η, η̇) -> (τ, λ)
-    return std::visit(
-        [&](const auto& c) {
-          const auto id = nhdyn::inverse_dynamics_with_forces(*any->tree, c);
-          return run_lines(std::cin, std::cout, [&](const line& l) {
-            l.expect_keys({"q", "eta", "eta_dot"});
-            const auto f = id(l.vector("q", c.dof()), l.vector("eta", c.m()), l.vector("eta_dot", c.m()));
-            return ordered_json{{"tau", to_json(Eigen::VectorXd(f.tau))}, {"lambda", to_json(Eigen::VectorXd(f.lambda))}};
-          });
-        },
-        *any->tree_constraint);
-  if (any->tree) {
-    const auto& t = *any->tree;
-    const auto id = nhdyn::rne(t);
-    const int n = t.dof();
-    return run_lines(std::cin, std::cout, [&](const line& l) {
-      l.expect_keys({"q", "qd", "qdd"});
-      const Eigen::VectorXd tau = id(l.vector("q", n), l.vector("qd", n), l.vector("qdd", n));
-      return ordered_json{{"tau", to_json(tau)}};
-    });
-  }
-  const auto& m = *any->dh;
-  const auto& ch = m.chain;
-  const int n = ch.dof();
-  if (!m.constraint)
-    return run_lines(std::cin, std::cout, [&](const line& l) {
-      if (l.has("eta") || l.has("eta_dot"))
-        throw nhdyn::input_error("model '" + ch.name() + "' has no constraint: lines are {\"q\", \"qd\", \"qdd\"}");
-      return holonomic(ch, l);
-    });
-  const auto& c = *m.constraint;
-  const auto id = nhdyn::inverse_dynamics_with_forces(ch, c);
-  return run_lines(std::cin, std::cout, [&](const line& l) {
-    if (l.has("qd") || l.has("qdd"))
-      throw nhdyn::input_error("model '" + ch.name() +
-                               "' has a constraint: lines are {\"q\", \"eta\", \"eta_dot\"} (eta has " +
-                               std::to_string(c.m()) + " entries)");
-    l.expect_keys({"q", "eta", "eta_dot"});
-    const auto f = id(l.vector("q", n), l.vector("eta", c.m()), l.vector("eta_dot", c.m()));
-    return ordered_json{{"tau", to_json(Eigen::VectorXd(f.tau))}, {"lambda", to_json(Eigen::VectorXd(f.lambda))}};
-  });
+  return dispatch(
+      *any, [&](const auto& model, const auto& c) { return constrained(model, c, any->name()); },
+      [&](const auto& model) { return holonomic(model, any->name()); });
 }
 }  // namespace
 

@@ -28,8 +28,8 @@ namespace nhdyn {
 
 namespace reference {
 /// q̈ by the articulated-body algorithm (RBDA Table 7.1), gravity as the base acceleration
-/// a_0 = −a_g. `check(i, D_i, scale_i)` is called with every articulated inertia along the
-/// joint axis (and its scale) before it is divided by.
+/// a_0 = −a_g. `check(i, D_i, U_i, S_i)` sees every articulated inertia along a joint axis,
+/// D_i = S_iᵀ U_i with U_i = I^A_i S_i, before it is divided by.
 template <class T, class S, class Check>
 vecX<T> aba(const tree<S>& t, const vecX<T>& q, const vecX<T>& qd, const vecX<T>& tau, const Check& check) {
   using namespace spatial;
@@ -51,7 +51,7 @@ vecX<T> aba(const tree<S>& t, const vecX<T>& q, const vecX<T>& qd, const vecX<T>
   for (int i = n - 1; i >= 0; --i) {  // pass 2: articulated inertias, leaves to root
     U[i] = IA[i] * Si[i];
     D[i] = Si[i].dot(U[i]);  // (7.37)
-    check(i, D[i], T(U[i].norm() * Si[i].norm()));
+    check(i, D[i], U[i], Si[i]);
     u[i] = tau(i) - Si[i].dot(pA[i]);
     const int l = t.parent(i);
     if (l >= 0) {
@@ -75,7 +75,7 @@ vecX<T> aba(const tree<S>& t, const vecX<T>& q, const vecX<T>& qd, const vecX<T>
 /// The same, unchecked.
 template <class T, class S>
 vecX<T> aba(const tree<S>& t, const vecX<T>& q, const vecX<T>& qd, const vecX<T>& tau) {
-  return aba<T>(t, q, qd, tau, [](int, const T&, const T&) {});
+  return aba<T>(t, q, qd, tau, [](int, const T&, const spatial::vec6<T>&, const spatial::vec6<T>&) {});
 }
 }  // namespace reference
 
@@ -99,8 +99,9 @@ class aba_fn : public stage_tag {
     detail::check_finite(q, "q");
     detail::check_finite(qd, "qd");
     detail::check_finite(tau, "tau");
-    const auto check = [&](int i, const T& D, const T& scale) {
-      const double d = value_of(D), s = value_of(scale);
+    const auto check = [&](int i, const T& D, const spatial::vec6<T>& U, const spatial::vec6<T>& Si) {
+      const auto norm = [](const spatial::vec6<T>& v) { return v.unaryExpr([](const T& x) { return value_of(x); }).template cast<double>().norm(); };
+      const double d = value_of(D), s = norm(U) * norm(Si);  // D ≤ |U||S| (Cauchy–Schwarz)
       if (std::isfinite(d) && d > 64 * std::numeric_limits<double>::epsilon() * s) return;
       std::ostringstream os;
       os << "aba: model '" << t_.name() << "', joint '" << t_[i].joint_name

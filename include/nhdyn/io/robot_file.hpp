@@ -24,7 +24,6 @@
 ///   sideways; η = (v, δ̇, other joint rates); k = 2.
 #include <filesystem>
 #include <fstream>
-#include <iostream>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -102,8 +101,7 @@ inline double axis_sign(const Eigen::Vector3d& a, int e, const std::string& wher
   if (off > 1e-3) throw model_error(os.str());
   if (off > 1e-9) {
     os << " to " << off << "; taken as exact";
-    if (opt.warn) opt.warn(os.str());
-    else std::cerr << "nhdyn: warning: " << os.str() << '\n';
+    opt.warning(os.str());
   }
   return a(e) > 0 ? 1.0 : -1.0;
 }
@@ -173,8 +171,7 @@ inline robot_constraint read_robot_constraint(const json& c, const tree<double>&
         os << at.prefix << ": the steering joint '" << t[s].joint_name << "' is at (" << J.origin.x() << ", "
            << J.origin.y() << ") m in the root link's frame, not on the front axle at (" << L
            << ", 0); the model puts the front wheel at (wheelbase, 0)";
-        if (opt.warn) opt.warn(os.str());
-        else std::cerr << "nhdyn: warning: " << os.str() << '\n';
+        opt.warning(os.str());
       }
       return bicycle<double>(n, s, L, sign);
     }

@@ -44,6 +44,13 @@ struct urdf_options {
   vec3<double> gravity{0, 0, -9.81};
   /// Where warnings go; default: one line each on stderr, prefixed "nhdyn: warning: ".
   std::function<void(const std::string&)> warn{};
+  /// Sends one warning where `warn` says.
+  void warning(const std::string& msg) const {
+    if (warn)
+      warn(msg);
+    else
+      std::cerr << "nhdyn: warning: " << msg << "\n";
+  }
   /// A planar base in front of the URDF's joints: q = (base_x, base_y, base_yaw, the URDF's
   /// joints), the root link's pose on the floor (x, y along the world axes, yaw about world
   /// z). The root link then moves: its own <inertial> and those of links fixed to it count.
@@ -138,12 +145,7 @@ inline tree<double> parse_urdf(const std::string& text, const std::string& where
     }
     urdfdom_warnings = std::move(capture.warnings);
   }
-  const auto warn = [&](const std::string& msg) {
-    if (opt.warn)
-      opt.warn(where + ": " + msg);
-    else
-      std::cerr << "nhdyn: warning: " << where << ": " << msg << "\n";
-  };
+  const auto warn = [&](const std::string& msg) { opt.warning(where + ": " + msg); };
   for (const auto& w : urdfdom_warnings) warn("urdfdom: " + w);
   const auto line_of_link = [&](const std::string& n) {
     const auto it = doc.link_line.find(n);
