@@ -79,7 +79,10 @@ any_model load_any_model(const std::string& spec, bool strict) {
   o.strict = strict;
   if (robot) {
     auto r = nhdyn::io::load_robot_file(spec, o);
-    return {std::nullopt, std::move(r.model), r.constraint};
+    // the robot file's name (its "name", else the URDF's) names the model in output and messages
+    const auto& t = r.model;
+    return {std::nullopt, nhdyn::tree<double>(t.bodies(), t.gravity(), r.name, t.validation_policy(), t.root_name(), t.frames()),
+            r.constraint};
   }
   return {std::nullopt, nhdyn::io::load_urdf(spec, o), std::nullopt};
 #else

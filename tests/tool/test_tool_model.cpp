@@ -200,6 +200,7 @@ TEST_CASE("tool: robot files with each constraint type in model, id, fd, lineari
           auto r = run_tool("model --model '" + file + "'");
           REQUIRE(r.status == 0);
           const json j = json::parse(r.lines[0]);
+          CHECK(j["name"] == name);  // the robot file's "name", not its URDF's
           CHECK(j["k"] == c.k());
           CHECK(j["eta"] == json(robot.eta_names()));
           std::mt19937_64 rng(11);
