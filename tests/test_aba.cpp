@@ -153,3 +153,50 @@ TEST_CASE("aba refuses only a truly singular or non-finite problem, and says whi
   CHECK_THROWS_WITH(aba(t)(bad, z, z), Catch::Matchers::Contains("q"));
   CHECK_THROWS_WITH(aba(t)(z, VectorXd::Zero(3), z), Catch::Matchers::Contains("qd"));
 }
+
+TEST_CASE("forward_dynamics picks ABA or CRBA + LDLT as documented, with the same answers", "[aba]") {
+  std::mt19937_64 rng(1540);
+  const auto same = [](const VectorXd& a, const VectorXd& b) { return (a - b).cwiseAbs().maxCoeff() == 0.0; };
+  for (int n : {6, 39, 40, 50}) {
+    const auto t = nhdyn_ref::random_tree(rng, n, 0.3, true);
+    const VectorXd q = random_vec(rng, n, 2), qd = random_vec(rng, n, 2), tau = random_vec(rng, n, 5);
+    const VectorXd by_aba = forward_dynamics(t, {}, {.method = fd_method::aba})(q, qd, tau);
+    const VectorXd by_crba = forward_dynamics(t, {}, {.method = fd_method::crba_ldlt})(q, qd, tau);
+    const VectorXd automatic = forward_dynamics(t)(q, qd, tau);
+    INFO("n = " << n);
+    CHECK(same(by_aba, aba(t)(q, qd, tau)));
+    CHECK(rel(by_aba, by_crba) <= 1e-9);
+    CHECK(same(automatic, n >= 40 ? by_aba : by_crba));
+    // options: without gravity and velocity terms, both algorithms agree
+    for (rne_options o : {rne_options{false, true}, rne_options{true, false}, rne_options{false, false}}) {
+      const VectorXd a = forward_dynamics(t, o, {.method = fd_method::aba})(q, qd, tau);
+      const VectorXd b = forward_dynamics(t, o, {.method = fd_method::crba_ldlt})(q, qd, tau);
+      CHECK(rel(a, b) <= 1e-9);
+      CHECK(rel(VectorXd(rne(t, o)(q, qd, a)), tau) <= 1e-9);
+    }
+    // chains: the same rule (a chain's forward dynamics runs ABA on it as a tree)
+    if (n == 6) {
+      const auto p = presets::puma560();
+      const VectorXd q6 = random_vec(rng, 6, 2), qd6 = random_vec(rng, 6, 1), t6 = random_vec(rng, 6, 5);
+      CHECK(same(forward_dynamics(p, {}, {.method = fd_method::aba})(q6, qd6, t6), aba(as_tree(p))(q6, qd6, t6)));
+      CHECK(rel(forward_dynamics(p)(q6, qd6, t6), aba(as_tree(p))(q6, qd6, t6)) <= 1e-10);
+    }
+  }
+  // ill-conditioned M (a light base carrying heavy links: scaled pivot ratio past √(1/ε)):
+  // automatic answers by ABA, the more accurate of the two there
+  const auto light = mass_span_chain(rng, 16, 1);
+  const VectorXd q = random_vec(rng, 16, 2), qd = random_vec(rng, 16, 1), tau = random_vec(rng, 16, 5);
+  const auto M = mass_matrix(light)(q);
+  const double ratio = 1.0 / ldlt_factor<double, dynamic>(M).min_scaled_pivot;
+  REQUIRE(ratio > 6.8e7);
+  CHECK(same(forward_dynamics(light)(q, qd, tau), aba(light)(q, qd, tau)));
+  // a joint that moves nothing: CRBA + LDLT refuses, so does ABA, naming the joint
+  std::vector<body<double>> B{body<double>{}};
+  B[0].name = "b";
+  B[0].joint_name = "idle";
+  const tree<double> idle(B, vec3<double>(0, 0, -9.81), "idle");
+  CHECK_THROWS_WITH(forward_dynamics(idle, {}, {.method = fd_method::aba})(VectorXd::Zero(1), VectorXd::Zero(1), VectorXd::Ones(1)),
+                    Catch::Contains("joint 'idle'") && Catch::Contains("singular"));
+  CHECK_THROWS_WITH(forward_dynamics(idle)(VectorXd::Zero(1), VectorXd::Zero(1), VectorXd::Ones(1)),
+                    Catch::Contains("mass matrix M(q) is not positive definite"));
+}

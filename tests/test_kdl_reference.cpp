@@ -161,6 +161,40 @@ TEST_CASE("kdl: rne equals KDL's ChainIdSolver_RNE on puma560 and paper5, fixed 
   CHECK(g(2) == Approx(0.2489).margin(1e-4));
 }
 
+TEST_CASE("kdl: rne with external wrenches equals ChainIdSolver_RNE with f_ext") {
+  // KDL's f_ext[i]: the wrench on segment i from the environment, in segment i's (tip) frame =
+  // DH frame i, about its origin — nhdyn's wrench on link i in wrench_frame::body at point 0.
+  // A second set at random points (the moment moved to the origin for KDL: m + p × f).
+  std::mt19937_64 rng(77);
+  worst w("rne with wrenches vs KDL f_ext, random chains");
+  for (int n = 1; n <= 9; ++n) {
+    const auto c = nhdyn_ref::random_chain(rng, n, {.prismatic_probability = 0.3});
+    KDL::Chain kc = to_kdl(c);
+    KDL::ChainIdSolver_RNE id_kdl(kc, kdl_vector(c.gravity()));
+    for (int s = 0; s < 4; ++s) {
+      const Eigen::VectorXd q = random_vector(rng, n, -3.1, 3.1), qd = random_vector(rng, n, -2, 2),
+                            qdd = random_vector(rng, n, -3, 3);
+      KDL::Wrenches f_ext(kc.getNrOfSegments(), KDL::Wrench::Zero());
+      std::vector<nhdyn::wrench<double>> W;
+      for (int i = 0; i < n; ++i) {
+        nhdyn::wrench<double> x;
+        x.body = i + 1;
+        x.frame = nhdyn::wrench_frame::body;
+        x.force = random_vector(rng, 3, -10, 10);
+        x.moment = random_vector(rng, 3, -3, 3);
+        if (s % 2) x.point = random_vector(rng, 3, -0.5, 0.5);
+        const Eigen::Vector3d m0 = x.moment + x.point.cross(x.force);
+        f_ext[std::size_t(i)] = KDL::Wrench(kdl_vector(x.force), kdl_vector(m0));
+        W.push_back(x);
+      }
+      KDL::JntArray tau(static_cast<unsigned>(n));
+      REQUIRE(id_kdl.CartToJnt(jnt(q), jnt(qd), jnt(qdd), f_ext, tau) >= 0);
+      const Eigen::VectorXd v = nhdyn::rne(c)(q, qd, qdd, nhdyn::external_wrenches(c, W));
+      CHECK(w(rel(v, tau.data)) < 1e-12);
+    }
+  }
+}
+
 TEST_CASE("kdl: forward kinematics and the tip Jacobian equal KDL's") {
   std::mt19937_64 rng(33);
   worst w("frames and tip Jacobian vs KDL (absolute / scale)");

@@ -418,3 +418,52 @@ TEST_CASE("bicycle: a misplaced steering joint warns and goes on", "[wheeled]") 
   REQUIRE(warnings.size() == 1);
   CHECK_THAT(warnings[0], Catch::Matchers::Contains("not on the front axle"));
 }
+
+TEST_CASE("robot files: drives by joint name (motor side, joint side) reach the dynamics", "[wheeled]") {
+  const auto text = [](const std::string& drives) {
+    return R"({"urdf": "../urdf/mobile_manipulator.urdf", "base": {"type": "planar"}, "drives": )" + drives +
+           R"(, "constraint": {"type": "wheels", "left": "wheel_left_joint", "right": "wheel_right_joint", "radius": 0.1}})";
+  };
+  const auto parse = [&](const std::string& drives) {
+    return io::parse_robot_file(text(drives), robot_path("drives.json"));
+  };
+  const auto plain = load("mobile_manipulator_wheels.json");
+  const auto driven = parse(R"({"wheel_left_joint": {"motor": {"gear": 20, "inertia": 1e-4, "viscous": 1e-3, "coulomb": 0.01}},
+                                "arm_1_joint": {"armature": 0.3, "friction": {"viscous": 2, "coulomb": [1, -0.5]}}})");
+  const auto joint = [&](const std::string& name) {
+    for (int i = 0; i < driven.model.dof(); ++i)
+      if (driven.model[i].joint_name == name) return i;
+    return -1;
+  };
+  const int w = joint("wheel_left_joint");
+  REQUIRE(w >= 0);
+  CHECK(driven.model[w].armature == Approx(400 * 1e-4).epsilon(1e-15));
+  CHECK(driven.model[w].friction_law() == joint_friction{0.4, 0.2, -0.2});
+  const int a = joint("arm_1_joint");
+  REQUIRE(a >= 0);
+  CHECK(driven.model[a].friction_law() == joint_friction{2, 1, -0.5});
+  // the left wheel's angle is a coordinate and η's first entry (q̇ = η there, Ṡ's row zero):
+  // its rotor adds exactly I_a η̇ to τ_left; the arm joint's adds I_a q̈ to the arm's entry
+  const auto& c0 = std::get<rolling_wheels<double>>(*plain.constraint);
+  const auto& c1 = std::get<rolling_wheels<double>>(*driven.constraint);
+  std::mt19937 rng(19);
+  for (int trial = 0; trial < 5; ++trial) {
+    const VectorXd q = random_q(c0.dof(), rng), eta = random_vec(c0.m(), rng), eta_dot = random_vec(c0.m(), rng);
+    const VectorXd t0 = inverse_dynamics(plain.model, c0)(q, eta, eta_dot);
+    const VectorXd t1 = inverse_dynamics(driven.model, c1)(q, eta, eta_dot);
+    VectorXd d = t1 - t0;
+    CHECK(d(0) == Approx(0.04 * eta_dot(0)).margin(1e-12));
+    const VectorXd qdd = VectorXd(apply_S(c1, q, eta_dot)) + VectorXd(apply_Sdot(c1, q, VectorXd(apply_S(c1, q, eta)), eta));
+    const auto names = driven.eta_names();
+    const int ea = int(std::find(names.begin(), names.end(), "arm_1_joint") - names.begin());
+    REQUIRE(ea < c1.m());
+    CHECK(d(ea) == Approx(0.3 * qdd(a)).margin(1e-12));
+    d(0) = d(ea) = 0;
+    CHECK(d.cwiseAbs().maxCoeff() <= 1e-12);
+  }
+  CHECK_THROWS_WITH(parse(R"({"no_such_joint": {"armature": 1}})"),
+                    Catch::Contains("drives, joint 'no_such_joint'") && Catch::Contains("wheel_left_joint"));
+  CHECK_THROWS_WITH(parse(R"({"wheel_left_joint": {"armature": -1}})"), Catch::Contains("armature"));
+  CHECK_THROWS_WITH(parse(R"({"wheel_left_joint": {"gear": 2}})"), Catch::Contains("gear"));
+  CHECK_THROWS_WITH(parse("[1]"), Catch::Contains("drives"));
+}

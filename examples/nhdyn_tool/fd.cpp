@@ -18,6 +18,8 @@ constexpr std::string_view usage = R"(nhdyn fd --model MODEL [--strict]
     {"q": [n], "eta": [m], "tau": [m]}       ->  {"eta_dot": [m]}     eta_dot = M_eta^-1 (S^T E tau - h_eta)
   A URDF model is a tree without a constraint (the first form; q in `nhdyn model` order); a
   robot file with a constraint takes the second form (eta as `nhdyn model` names it).
+  Either form takes an optional "f_ext" (external wrenches, as `nhdyn id --help` describes):
+  the motion they cause with tau.
   A singular or near-singular (reduced) mass matrix is an error line.
   --strict: a URDF inertia that is not physically valid is an error instead of a warning.
 )";
@@ -30,8 +32,10 @@ int constrained(const Model& model, const C& c, const std::string& name) {
     if (l.has("qd"))
       throw nhdyn::input_error("model '" + name + "' has a constraint: lines are {\"q\", \"eta\", \"tau\"} (eta and tau have " +
                                std::to_string(c.m()) + " entries)");
-    l.expect_keys({"q", "eta", "tau"});
-    const Eigen::VectorXd eta_dot = fd(l.vector("q", c.dof()), l.vector("eta", c.m()), l.vector("tau", c.m()));
+    l.expect_keys(with_f_ext(l, {"q", "eta", "tau"}));
+    const Eigen::VectorXd q = l.vector("q", c.dof()), eta = l.vector("eta", c.m()), tau = l.vector("tau", c.m());
+    const Eigen::VectorXd eta_dot = l.has("f_ext") ? Eigen::VectorXd(fd(q, eta, tau, nhdyn::external_wrenches(model, wrenches_of(l, model))))
+                                                   : Eigen::VectorXd(fd(q, eta, tau));
     return ordered_json{{"eta_dot", to_json(eta_dot)}};
   });
 }
@@ -43,8 +47,10 @@ int holonomic(const Model& model, const std::string& name) {
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("eta"))
       throw nhdyn::input_error("model '" + name + "' has no constraint: lines are {\"q\", \"qd\", \"tau\"}");
-    l.expect_keys({"q", "qd", "tau"});
-    const Eigen::VectorXd qdd = fd(l.vector("q", n), l.vector("qd", n), l.vector("tau", n));
+    l.expect_keys(with_f_ext(l, {"q", "qd", "tau"}));
+    const Eigen::VectorXd q = l.vector("q", n), qd = l.vector("qd", n), tau = l.vector("tau", n);
+    const Eigen::VectorXd qdd = l.has("f_ext") ? Eigen::VectorXd(fd(q, qd, tau, nhdyn::external_wrenches(model, wrenches_of(l, model))))
+                                               : Eigen::VectorXd(fd(q, qd, tau));
     return ordered_json{{"qdd", to_json(qdd)}};
   });
 }

@@ -19,6 +19,11 @@ constexpr std::string_view usage = R"(nhdyn id --model MODEL [--strict]
     {"q": [n], "eta": [m], "eta_dot": [m]}   ->  {"tau": [m], "lambda": [k]}
   A URDF model is a tree without a constraint (the first form; q in `nhdyn model` order); a
   robot file with a constraint takes the second form (eta as `nhdyn model` names it).
+  Either form takes an optional "f_ext": external wrenches on bodies, each
+    {"body": NAME, "frame": "world" | "body", "point": [3], "force": [3], "moment": [3]}
+  (the environment's force [N] and moment [N m] about the point on the body; point in the
+  body's frame [m]; force and moment in the world's or the body's axes; DH models name their
+  bodies link1 ... linkN). tau (and lambda) are then what balances them as well.
   Keys must be exactly those of the model's form; anything else is an error line.
   --strict: a URDF inertia that is not physically valid is an error instead of a warning.
 )";
@@ -31,9 +36,15 @@ int constrained(const Model& model, const C& c, const std::string& name) {
     if (l.has("qd") || l.has("qdd"))
       throw nhdyn::input_error("model '" + name + "' has a constraint: lines are {\"q\", \"eta\", \"eta_dot\"} (eta has " +
                                std::to_string(c.m()) + " entries)");
-    l.expect_keys({"q", "eta", "eta_dot"});
-    const auto f = id(l.vector("q", c.dof()), l.vector("eta", c.m()), l.vector("eta_dot", c.m()));
-    return ordered_json{{"tau", to_json(Eigen::VectorXd(f.tau))}, {"lambda", to_json(Eigen::VectorXd(f.lambda))}};
+    l.expect_keys(with_f_ext(l, {"q", "eta", "eta_dot"}));
+    const Eigen::VectorXd q = l.vector("q", c.dof()), eta = l.vector("eta", c.m()), eta_dot = l.vector("eta_dot", c.m());
+    const auto out = [](const auto& f) {
+      return ordered_json{{"tau", to_json(Eigen::VectorXd(f.tau))}, {"lambda", to_json(Eigen::VectorXd(f.lambda))}};
+    };
+    if (!l.has("f_ext")) return out(id(q, eta, eta_dot));
+    const auto fx = nhdyn::external_wrenches(model, wrenches_of(l, model));
+    return out((nhdyn::lift(c) | nhdyn::rne(model) | fx | nhdyn::constraint_forces(c))(
+        nhdyn::reduced_state<double>{q, eta, eta_dot}));
   });
 }
 /// Lines of a holonomic model: (q, q̇, q̈) -> τ.
@@ -44,8 +55,10 @@ int holonomic(const Model& model, const std::string& name) {
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("eta") || l.has("eta_dot"))
       throw nhdyn::input_error("model '" + name + "' has no constraint: lines are {\"q\", \"qd\", \"qdd\"}");
-    l.expect_keys({"q", "qd", "qdd"});
-    const Eigen::VectorXd tau = id(l.vector("q", n), l.vector("qd", n), l.vector("qdd", n));
+    l.expect_keys(with_f_ext(l, {"q", "qd", "qdd"}));
+    const Eigen::VectorXd q = l.vector("q", n), qd = l.vector("qd", n), qdd = l.vector("qdd", n);
+    const Eigen::VectorXd tau = l.has("f_ext") ? Eigen::VectorXd(id(q, qd, qdd, nhdyn::external_wrenches(model, wrenches_of(l, model))))
+                                               : Eigen::VectorXd(id(q, qd, qdd));
     return ordered_json{{"tau", to_json(tau)}};
   });
 }

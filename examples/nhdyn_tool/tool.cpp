@@ -187,6 +187,62 @@ Eigen::VectorXd line::vector(std::string_view key, int n) const {
   return v;
 }
 
+located_body locate_body(const nhdyn::tree<double>& t, const std::string& name) {
+  const auto f = t.find_frame(name);  // input_error naming the model for an unknown name
+  return {f.body + 1, f.R, f.p};
+}
+located_body locate_body(const nhdyn::chain<double>& c, const std::string& name) {
+  if (name == "base") return {};
+  const std::string pre = "link";
+  if (name.size() > pre.size() && name.compare(0, pre.size(), pre) == 0 &&
+      name.find_first_not_of("0123456789", pre.size()) == std::string::npos && name.size() <= pre.size() + 6) {
+    const int i = std::stoi(name.substr(pre.size()));
+    if (i >= 1 && i <= c.dof()) return {i};
+  }
+  throw nhdyn::input_error("model '" + c.name() + "' has no body '" + name + "' (bodies: base, link1 … link" +
+                           std::to_string(c.dof()) + ")");
+}
+
+std::vector<nhdyn::wrench<double>> line_wrenches(const line& l,
+                                                 const std::function<located_body(const std::string&)>& locate) {
+  std::vector<nhdyn::wrench<double>> out;
+  if (!l.has("f_ext")) return out;
+  const json& a = l.raw()["f_ext"];
+  if (!a.is_array()) throw nhdyn::input_error("'f_ext' is a " + kind(a) + ", not a list of wrenches");
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    const std::string w = "'f_ext'[" + std::to_string(k) + "]";
+    const json& e = a[k];
+    if (!e.is_object()) throw nhdyn::input_error(w + " is a " + kind(e) + ", not an object {\"body\", \"force\", …}");
+    for (auto it = e.begin(); it != e.end(); ++it)
+      if (it.key() != "body" && it.key() != "frame" && it.key() != "point" && it.key() != "force" && it.key() != "moment")
+        throw nhdyn::input_error(w + ": unknown key '" + it.key() + "' (known: body, frame, point, force, moment)");
+    if (!e.contains("body") || !e["body"].is_string()) throw nhdyn::input_error(w + ": 'body' (a body name) is missing");
+    const located_body b = locate(e["body"].get<std::string>());
+    nhdyn::wrench_frame frame = nhdyn::wrench_frame::world;
+    if (e.contains("frame")) {
+      if (e["frame"] == "body") frame = nhdyn::wrench_frame::body;
+      else if (e["frame"] != "world") throw nhdyn::input_error(w + ": 'frame' must be \"world\" or \"body\"");
+    }
+    const auto v3 = [&](const char* key) {
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      if (!e.contains(key)) return v;
+      const json& x = e[key];
+      const std::string what = w + "." + key;
+      if (!x.is_array() || x.size() != 3) throw nhdyn::input_error(what + " is not a list of 3 numbers");
+      for (int r = 0; r < 3; ++r) v(r) = finite_number(x[std::size_t(r)], what + "[" + std::to_string(r) + "]");
+      return v;
+    };
+    nhdyn::wrench<double> x;
+    x.body = b.body;
+    x.frame = frame;
+    x.point = b.R * v3("point") + b.p;
+    x.force = frame == nhdyn::wrench_frame::body ? Eigen::Vector3d(b.R * v3("force")) : v3("force");
+    x.moment = frame == nhdyn::wrench_frame::body ? Eigen::Vector3d(b.R * v3("moment")) : v3("moment");
+    out.push_back(x);
+  }
+  return out;
+}
+
 Eigen::MatrixX2d line::intervals(std::string_view key, int n) const {
   const std::string k(key);
   if (!j_.contains(k)) throw nhdyn::input_error("missing key '" + k + "'");

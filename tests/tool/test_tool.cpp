@@ -379,3 +379,54 @@ TEST_CASE("tool: --help documents every subcommand; a bad command line is exit s
   CHECK(eq.status == 0);
   CHECK(eq.out.empty());
 }
+
+TEST_CASE("tool: f_ext on id and fd lines: the toolbox's published fext case, a constrained model, errors") {
+  // Corke's robotics-toolbox-python test_rne: puma.rne(qn, 0, 0, fext=[1, 2, 3, 1, 2, 3]) =
+  // [0.642756, 29.0866, 4.70321, 2.82843, -1.97175, 3]; its fext is what the end effector
+  // exerts (in frame 6), so the wrench on link6 is its negative.
+  const std::string qn = "[0, 0.7853981633974483, 3.141592653589793, 0, 0.7853981633974483, 0]";
+  const std::string f = R"(, "f_ext": [{"body": "link6", "frame": "body", "force": [-1, -2, -3], "moment": [-1, -2, -3]}])";
+  const auto r = run_tool("id --model puma560_motors",
+                          R"({"q": )" + qn + R"(, "qd": [0, 0, 0, 0, 0, 0], "qdd": [0, 0, 0, 0, 0, 0])" + f + "}\n");
+  REQUIRE(r.status == 0);
+  const VectorXd tau = field(r.lines[0], "tau");
+  const VectorXd published = (VectorXd(6) << 0.642756, 29.0866, 4.70321, 2.82843, -1.97175, 3).finished();
+  const VectorXd half_unit = (VectorXd(6) << 5e-7, 5e-5, 5e-6, 5e-6, 5e-6, 5e-6).finished();  // of the printed digits
+  for (int i = 0; i < 6; ++i) CHECK(std::abs(tau(i) - published(i)) <= half_unit(i));
+  // fd with the same wrench at that tau gives back qdd = 0
+  const auto fd = run_tool("fd --model puma560_motors",
+                           R"({"q": )" + qn + R"(, "qd": [0, 0, 0, 0, 0, 0], "tau": )" + arr(tau) + f + "}\n");
+  REQUIRE(fd.status == 0);
+  CHECK(field(fd.lines[0], "qdd").cwiseAbs().maxCoeff() <= 1e-9);
+  // a constrained model: a payload's weight on the arm's last link changes tau and lambda as
+  // the library's composition lift | rne | wrenches | constraint_forces does
+  const auto p = nhdyn::presets::paper5();
+  const VectorXd q = (VectorXd(5) << 0.1, 0.2, 0.3, 0.4, 0.5).finished(), eta = (VectorXd(4) << 0.3, -0.2, 0.1, 0.4).finished(),
+                 eta_dot = (VectorXd(4) << 0.5, 0.1, -0.3, 0.2).finished();
+  const auto c = run_tool("id --model paper5", R"({"q": )" + arr(q) + R"(, "eta": )" + arr(eta) + R"(, "eta_dot": )" + arr(eta_dot) +
+                                                   R"(, "f_ext": [{"body": "link5", "point": [0, 0, 0], "force": [-4.905, 0, 0]}]})" "\n");
+  REQUIRE(c.status == 0);
+  nhdyn::wrench<double> w;
+  w.body = 5;
+  w.force = Eigen::Vector3d(-4.905, 0, 0);
+  const auto ch = p.chain.dynamic_size();
+  const nhdyn::differential_drive<double> dd(5, 0, 1, 2, 0.0, -1.0);
+  const auto ref = (nhdyn::lift(dd) | nhdyn::rne(ch) | nhdyn::external_wrenches(ch, {w}) | nhdyn::constraint_forces(dd))(
+      nhdyn::reduced_state<double>{q, eta, eta_dot});
+  require_close(field(c.lines[0], "tau"), VectorXd(ref.tau), 1e-14);
+  require_close(field(c.lines[0], "lambda"), VectorXd(ref.lambda), 1e-14);
+  // errors name the entry and the field; the other lines go on
+  const auto bad = run_tool("id --model puma560",
+                            R"({"q": [0, 0, 0, 0, 0, 0], "qd": [0, 0, 0, 0, 0, 0], "qdd": [0, 0, 0, 0, 0, 0], "f_ext": [{"body": "link7"}]})" "\n"
+                            R"({"q": [0, 0, 0, 0, 0, 0], "qd": [0, 0, 0, 0, 0, 0], "qdd": [0, 0, 0, 0, 0, 0], "f_ext": [{"body": "link1", "force": [1, 2]}]})" "\n"
+                            R"({"q": [0, 0, 0, 0, 0, 0], "qd": [0, 0, 0, 0, 0, 0], "qdd": [0, 0, 0, 0, 0, 0], "f_ext": [{"body": "link1", "frame": "tool"}]})" "\n"
+                            R"({"q": [0, 0, 0, 0, 0, 0], "qd": [0, 0, 0, 0, 0, 0], "qdd": [0, 0, 0, 0, 0, 0], "f_ext": [{"body": "link1", "torque": [0, 0, 1]}]})" "\n"
+                            R"({"q": [0, 0, 0, 0, 0, 0], "qd": [0, 0, 0, 0, 0, 0], "qdd": [0, 0, 0, 0, 0, 0], "f_ext": []})" "\n");
+  CHECK(bad.status == 1);
+  REQUIRE(bad.lines.size() == 5);
+  CHECK_THAT(bad.lines[0], Catch::Contains("no body 'link7'"));
+  CHECK_THAT(bad.lines[1], Catch::Contains("'f_ext'[0].force is not a list of 3 numbers"));
+  CHECK_THAT(bad.lines[2], Catch::Contains("'frame' must be"));
+  CHECK_THAT(bad.lines[3], Catch::Contains("unknown key 'torque'"));
+  CHECK_THAT(bad.lines[4], Catch::Contains("\"tau\""));
+}

@@ -78,14 +78,32 @@ class nh_forward_dynamics_fn : public stage_tag {
   template <class Q, class E, class TAU>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                   const Eigen::MatrixBase<TAU>& tau) const {
-    using T = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
+    using T0 = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
+    return solve(q, eta, tau, static_cast<const vecN<T0, N>*>(nullptr));
+  }
+  /// With applied forces (external wrenches, dynamics/wrench.hpp):
+  /// η̇ = M_η⁻¹ (SᵀE τ + Sᵀ Q_ext(q) − h_η).
+  template <class Q, class E, class TAU, applied_forces F>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
+                  const F& fx) const {
+    detail::check_size(q, c_.dof(), "q");
+    const auto Qx = fx.generalized_force(q);
+    return solve(q, eta, tau, &Qx);
+  }
+
+ private:
+  template <class Q, class E, class TAU, class QX>
+  auto solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
+             const QX* Qx) const {
+    using T0 = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
+    using T = promote_t<T0, typename QX::Scalar>;
     detail::check_size(q, c_.dof(), "q");
     detail::check_size(eta, c_.m(), "eta");
     detail::check_size(tau, c_.m(), "tau");
     detail::check_finite(q, "q");
     detail::check_finite(eta, "eta");
     detail::check_finite(tau, "tau");
-    const vecN<T, M> h = reduced_bias(q, eta);
+    const vecN<T0, M> h = reduced_bias(q, eta);
     vecN<T, M> u;
     constexpr bool has_E = has_input_map<C, Q>;
     if constexpr (has_identity_StE<C>) {
@@ -98,11 +116,14 @@ class nh_forward_dynamics_fn : public stage_tag {
       const auto Sq = c_.S(q);
       u = (Sq.transpose() * Sq).template cast<T>() * tau.template cast<T>();
     }
+    if (Qx) u += apply_St(c_, q, *Qx).template cast<T>();
     const auto f = ldlt_factor<T, M>(reduced_inertia(q), "the reduced inertia M_η = SᵀMS");
-    vecN<T, M> eta_dot = f.solve(u - h);
+    vecN<T, M> eta_dot = f.solve(u - h.template cast<T>());
     detail::check_overflow(eta_dot, "nh_forward_dynamics");
     return eta_dot;
   }
+
+ public:
 
   /// The state derivative for integrators: x = (q, η) ↦ ẋ = (q̇, η̇) = (S η, η̇), n + m entries.
   template <class Q, class E, class TAU>

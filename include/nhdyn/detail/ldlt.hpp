@@ -22,6 +22,9 @@ template <class T, int N>
 struct ldlt {
   Eigen::Matrix<T, N, N> L;  // unit lower triangle below the diagonal, D on it
   double min_pivot = 0, max_pivot = 0;
+  /// The smallest pivot of the diagonally scaled matrix, d_j / M_jj ∈ (0, 1]: 1/it is a lower
+  /// bound of the scaled condition number, which is what a solve loses digits to.
+  double min_scaled_pivot = 1;
 
   /// Ratio of the largest to the smallest pivot: a cheap lower estimate of cond(M).
   double pivot_ratio() const { return min_pivot > 0 ? max_pivot / min_pivot : INFINITY; }
@@ -92,6 +95,7 @@ ldlt<T, N> ldlt_factor(const Eigen::Matrix<T, N, N>& M, const char* what = "matr
   }
   f.min_pivot = dmin;
   f.max_pivot = dmax;
+  f.min_scaled_pivot = smin;
   if (1.0 / smin > max_ratio) {
     std::ostringstream os;
     os << what << " is numerically singular (scaled pivot " << jmin << " = " << smin << ": the diagonally scaled "

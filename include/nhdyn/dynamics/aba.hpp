@@ -50,7 +50,7 @@ vecX<T> aba(const tree<S>& t, const vecX<T>& q, const vecX<T>& qd, const vecX<T>
   }
   for (int i = n - 1; i >= 0; --i) {  // pass 2: articulated inertias, leaves to root
     U[i] = IA[i] * Si[i];
-    D[i] = Si[i].dot(U[i]);  // (7.37)
+    D[i] = Si[i].dot(U[i]) + T(t[i].armature);  // (7.37), with the joint's armature
     check(i, D[i], U[i], Si[i]);
     u[i] = tau(i) - Si[i].dot(pA[i]);
     const int l = t.parent(i);
@@ -106,9 +106,12 @@ class aba_fn : public stage_tag {
       std::ostringstream os;
       os << "aba: model '" << t_.name() << "', joint '" << t_[i].joint_name
          << "': the articulated inertia along the joint axis is D = " << d;
-      if (std::isfinite(d) && d > 0)
-        os << ", numerically zero against its scale " << s << " (64 ε)";
-      os << ": the forward dynamics is singular there (nothing with mass or inertia moves with this joint)";
+      if (std::isfinite(d) && d < 0) {
+        os << ", negative: the model's inertias are not physical (an articulated inertia is positive semi-definite)";
+      } else {
+        if (std::isfinite(d) && d > 0) os << ", numerically zero against its scale " << s << " (64 ε)";
+        os << ": the forward dynamics is singular there (nothing with mass or inertia moves with this joint)";
+      }
       throw numerical_error(os.str());
     };
     vecN<T, dynamic> out = reference::aba<T>(t_, vecN<T, dynamic>(q.template cast<T>()),
@@ -116,6 +119,17 @@ class aba_fn : public stage_tag {
                                              vecN<T, dynamic>(tau.template cast<T>()), check);
     detail::check_overflow(out, "aba");
     return out;
+  }
+
+  /// With applied forces (external wrenches, dynamics/wrench.hpp): q̈ for τ + Q_ext(q).
+  template <class Q, class QD, class TAU, applied_forces F>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
+                  const F& fx) const {
+    detail::check_size(tau, t_.dof(), "tau");
+    const auto Qx = fx.generalized_force(q);
+    using R = promote_t<typename TAU::Scalar, typename decltype(Qx)::Scalar>;
+    const vecN<R, dynamic> t = tau.template cast<R>() + Qx.template cast<R>();
+    return (*this)(q, qd, t);
   }
 
  private:

@@ -1,20 +1,63 @@
 #pragma once
 /// \file dynamics/forward_dynamics.hpp
-/// Holonomic forward dynamics q̈ = M(q)⁻¹ (τ − h(q, q̇)), M by the composite-rigid-body
-/// algorithm, h by rne, solved by LDLᵀ. Throws numerical_error if M is singular (a chain
-/// whose last joints move no mass) or too ill-conditioned to give a digit.
+/// Holonomic forward dynamics q̈ = FD(q, q̇, τ) of a chain or a tree, by one of two algorithms:
+///
+/// - `fd_method::crba_ldlt`: M(q) by the composite-rigid-body algorithm, h by rne, solved by
+///   LDLᵀ (detail/ldlt.hpp: refuses a matrix singular by its scaled criterion);
+/// - `fd_method::aba`: Featherstone's articulated-body algorithm (dynamics/aba.hpp), O(n),
+///   never forming M;
+/// - `fd_method::automatic` (default): ABA from `aba_from` joints on (40: on revolute chains
+///   CRBA + LDLᵀ is faster up to 24 joints, ABA from 48, docs/performance.md), CRBA + LDLᵀ
+///   below — unless M's diagonally scaled pivots show it ill-conditioned (scaled ratio past
+///   √(1/ε) of the scalar: 6.7e7 in double, 4.1e3 in float, where LDLᵀ keeps fewer than half
+///   the digits): then ABA answers, which is more accurate there (docs/accuracy.md, mass
+///   spans). Where LDLᵀ refuses M (not positive definite, or a scaled ratio past 1/ε: no digit
+///   left), the refusal stands; `fd_method::aba` asks ABA regardless.
+///
+/// An optional last argument, external wrenches (dynamics/wrench.hpp), adds their generalized
+/// force to τ. `rne_options` drop gravity and/or the velocity terms, for both algorithms.
+#include <cmath>
+#include <optional>
+
 #include "../detail/ldlt.hpp"
+#include "aba.hpp"
 #include "mass_matrix.hpp"
+#include "tree.hpp"
 
 namespace nhdyn {
 
-template <class S, int N = dynamic>
-class forward_dynamics_fn : public stage_tag {
- public:
-  explicit forward_dynamics_fn(const chain<S, N>& c, rne_options o = {})
-      : M_(c), rne_(c, o) {}
+enum class fd_method { automatic, crba_ldlt, aba };
 
-  /// The 2-norm condition number of M(q) (double); operator() throws numerical_error past 1/ε.
+/// How forward_dynamics chooses (see the file comment).
+struct fd_options {
+  fd_method method = fd_method::automatic;
+  int aba_from = 40;                 ///< automatic: ABA from this many joints on
+  double aba_scaled_condition = 0;   ///< automatic: ABA past this scaled pivot ratio of M (0: √(1/ε) of T)
+};
+
+/// Model: chain<S, N> or tree<S> (N = dynamic).
+template <class S, int N = dynamic, class Model = chain<S, N>>
+class forward_dynamics_fn : public stage_tag {
+  using rne_type = decltype(rne(std::declval<const Model&>(), rne_options{}));
+  using mass_matrix_type = decltype(mass_matrix(std::declval<const Model&>()));
+
+ public:
+  explicit forward_dynamics_fn(const Model& m, rne_options o = {}, fd_options f = {})
+      : M_(m), rne_(m, o), opt_(o), fd_(f), n_(m.dof()) {
+    if (f.method != fd_method::crba_ldlt) {
+      tree<S> t;
+      if constexpr (std::is_same_v<Model, tree<S>>)
+        t = m;
+      else
+        t = as_tree(m);
+      if (!o.gravity) t = t.with_gravity(vec3<S>::Zero());
+      aba_.emplace(t);
+    }
+  }
+  int dof() const { return n_; }
+  fd_options options() const { return fd_; }
+
+  /// The 2-norm condition number of M(q) (double).
   template <class Q>
   double mass_matrix_condition(const Eigen::MatrixBase<Q>& q) const {
     return condition_number(M_(q));
@@ -24,24 +67,63 @@ class forward_dynamics_fn : public stage_tag {
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
                   const Eigen::MatrixBase<TAU>& tau) const {
     using X = typename Q::Scalar;
-    using T = promote_t<S, X>;
-    detail::check_size(tau, rne_.dof(), "tau");
+    using T = promote_t<promote_t<promote_t<S, X>, typename QD::Scalar>, typename TAU::Scalar>;
+    detail::check_size(tau, n_, "tau");
     detail::check_finite(tau, "tau");
-    const vecN<T, N> h = rne_(q, qd, vecN<X, N>::Zero(q.size()));
-    const auto f = ldlt_factor<T, N>(M_(q), "the mass matrix M(q)");
-    vecN<T, N> qdd = f.solve(tau.template cast<T>() - h);
+    if (fd_.method == fd_method::aba || (fd_.method == fd_method::automatic && n_ >= fd_.aba_from)) return by_aba<T>(q, qd, tau);
+    const auto h = rne_(q, qd, vecN<X, N>::Zero(q.size()));
+    std::optional<ldlt<T, N>> f;
+    if constexpr (std::is_same_v<T, promote_t<S, X>>)
+      f.emplace(ldlt_factor<T, N>(M_(q), "the mass matrix M(q)"));
+    else
+      f.emplace(ldlt_factor<T, N>(Eigen::Matrix<T, N, N>(M_(q).template cast<T>()), "the mass matrix M(q)"));
+    const double switch_at = fd_.aba_scaled_condition > 0 ? fd_.aba_scaled_condition : std::sqrt(default_max_pivot_ratio<T>());
+    if (fd_.method == fd_method::automatic && 1.0 / f->min_scaled_pivot > switch_at) return by_aba<T>(q, qd, tau);
+    vecN<T, N> qdd = f->solve(tau.template cast<T>() - h.template cast<T>());
     detail::check_overflow(qdd, "forward_dynamics");
     return qdd;
   }
 
+  /// With applied forces (external wrenches, dynamics/wrench.hpp): q̈ for τ + Q_ext(q).
+  template <class Q, class QD, class TAU, applied_forces F>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
+                  const F& fx) const {
+    detail::check_size(tau, n_, "tau");
+    const auto Qx = fx.generalized_force(q);
+    using R = promote_t<typename TAU::Scalar, typename decltype(Qx)::Scalar>;
+    const vecN<R, dynamic> t = tau.template cast<R>() + Qx.template cast<R>();
+    return (*this)(q, qd, t);
+  }
+
  private:
-  mass_matrix_fn<S, N> M_;
-  rne_fn<S, N> rne_;
+  template <class T, class Q, class QD, class TAU>
+  vecN<T, N> by_aba(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau) const {
+    using X = typename QD::Scalar;
+    const vecN<X, dynamic> v = opt_.velocity ? vecN<X, dynamic>(qd) : vecN<X, dynamic>::Zero(qd.size());
+    detail::check_size(qd, n_, "qd");
+    if (opt_.velocity) detail::check_finite(qd, "qd");
+    return (*aba_)(q, v, tau).template cast<T>();
+  }
+
+  mass_matrix_type M_;
+  rne_type rne_;
+  rne_options opt_;
+  fd_options fd_;
+  int n_;
+  std::optional<aba_fn<S>> aba_;
 };
 
 template <class S, int N>
-forward_dynamics_fn<S, N> forward_dynamics(const chain<S, N>& c, rne_options o = {}) {
-  return forward_dynamics_fn<S, N>(c, o);
+forward_dynamics_fn<S, N> forward_dynamics(const chain<S, N>& c, rne_options o = {}, fd_options f = {}) {
+  return forward_dynamics_fn<S, N>(c, o, f);
 }
+/// The holonomic forward dynamics of a tree.
+template <class S>
+forward_dynamics_fn<S, dynamic, tree<S>> forward_dynamics(const tree<S>& t, rne_options o = {}, fd_options f = {}) {
+  return forward_dynamics_fn<S, dynamic, tree<S>>(t, o, f);
+}
+/// The tree form's name before chains and trees shared one class.
+template <class S>
+using tree_forward_dynamics_fn = forward_dynamics_fn<S, dynamic, tree<S>>;
 
 }  // namespace nhdyn

@@ -58,6 +58,8 @@ class mass_matrix_fn : public stage_tag {
     detail::check_finite(q, "q");
     Eigen::Matrix<T, N, N> M(n_, n_);
     kernel<T>(q, M);
+    for (int i = 0; i < n_; ++i)  // the drives' rotor inertias (link::armature)
+      if (links_[std::size_t(i)].has_armature) M(i, i) += T(links_[std::size_t(i)].Ia);
     return M;
   }
 

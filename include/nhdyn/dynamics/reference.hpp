@@ -41,10 +41,14 @@ spatial::vec6<T> motion_subspace(const body<S>& b) {
   return s;
 }
 
-/// Inverse dynamics τ = M(q)q̈ + C(q,q̇)q̇ + g(q) by the recursive Newton–Euler algorithm
-/// (RBDA Table 5.1, eqs. 5.7–5.11), gravity as a fictitious base acceleration a_0 = −a_g.
+/// Inverse dynamics τ = M(q)q̈ + C(q,q̇)q̇ + g(q) − Σ Jᵀf^x by the recursive Newton–Euler
+/// algorithm (RBDA Table 5.1, eqs. 5.7–5.11), gravity as a fictitious base acceleration
+/// a_0 = −a_g. `fx` (optional, n entries): the external spatial force on each body, (moment
+/// about the body frame's origin; force), in body coordinates — RBDA's ⁱX_0* f^x_i already
+/// applied. A joint's armature I_a adds I_a q̈_i to τ_i (the rotor spins with the joint).
 template <class T, class S>
-vecX<T> rne(const tree<S>& t, const vecX<T>& q, const vecX<T>& qd, const vecX<T>& qdd, bool gravity = true) {
+vecX<T> rne(const tree<S>& t, const vecX<T>& q, const vecX<T>& qd, const vecX<T>& qdd, bool gravity = true,
+            const std::vector<spatial::vec6<T>>* fx = nullptr) {
   using namespace spatial;
   const int n = t.dof();
   std::vector<mat6<T>> X(n);  // ^iX_λ(i)
@@ -62,10 +66,11 @@ vecX<T> rne(const tree<S>& t, const vecX<T>& q, const vecX<T>& qd, const vecX<T>
     a[i] = X[i] * al + Si[i] * qdd(i) + crm(v[i]) * Si[i] * qd(i);     // (5.8)
     const mat6<T> I = inertia<T>(T(t[i].mass), t[i].com.template cast<T>(), t[i].inertia.template cast<T>());
     f[i] = I * a[i] + crf(v[i]) * I * v[i];                             // (5.9)
+    if (fx) f[i] -= (*fx)[i];
   }
   vecX<T> tau(n);
   for (int i = n - 1; i >= 0; --i) {
-    tau(i) = Si[i].dot(f[i]);                                           // (5.11)
+    tau(i) = Si[i].dot(f[i]) + T(t[i].armature) * qdd(i);              // (5.11)
     if (t.parent(i) >= 0) f[t.parent(i)] += X[i].transpose() * f[i];   // (5.10)
   }
   return tau;
@@ -90,7 +95,7 @@ matX<T> crba(const tree<S>& t, const vecX<T>& q) {
   matX<T> H = matX<T>::Zero(n, n);
   for (int i = 0; i < n; ++i) {
     vec6<T> F = Ic[i] * Si[i];
-    H(i, i) = Si[i].dot(F);
+    H(i, i) = Si[i].dot(F) + T(t[i].armature);
     for (int j = i; t.parent(j) >= 0;) {
       F = X[j].transpose() * F;
       j = t.parent(j);

@@ -5,7 +5,8 @@
 ///     v = rne(q, q̇, q̈) = M(q) q̈ + C(q, q̇) q̇ + g(q)          (n joint forces/torques)
 ///
 /// in link frames (Luh, Walker & Paul 1980; Spong, Hutchinson & Vidyasagar 2006, §7.5),
-/// generic over the scalar. Gravity enters as a base acceleration a_0 = −g. Links with zero
+/// generic over the scalar. A joint's armature I_a (link::armature, the reflected rotor
+/// inertia G²·J_m) adds I_a q̈_i to v_i, as it adds I_a to M's diagonal. Gravity enters as a base acceleration a_0 = −g. Links with zero
 /// mass and zero inertia are skipped; a link with zero mass but rotational inertia is not.
 ///
 /// Options say what a scene needs, and a call pays only for that:
@@ -186,11 +187,15 @@ void rne_kernel(const Links& L, const vec3<T>& g, const Q& q, const QD& qd, cons
     if (k.revolute) {
       const v3<std::remove_cvref_t<decltype(ca)>> p{k.p0[0], k.p0[1], k.p0[2]};
       m = m + c_cross(p, f) + s.Nn;
-      tau(i) = sa * m.y + ca * m.z;  // z_{i−1} · n_i
+      T t = sa * m.y + ca * m.z;  // z_{i−1} · n_i
+      if (k.has_armature) t += T(k.Ia) * T(qdd(i));  // read before τ_i overwrites it (in place)
+      tau(i) = t;
     } else {
       const T d(k.d0 + q(i));
       m = m + cross(v3<T>{T(k.a), T(d * sa), T(d * ca)}, f) + s.Nn;
-      tau(i) = sa * f.y + ca * f.z;  // z_{i−1} · f_i
+      T t = sa * f.y + ca * f.z;  // z_{i−1} · f_i
+      if (k.has_armature) t += T(k.Ia) * T(qdd(i));
+      tau(i) = t;
     }
   }
   // The translating prefix: forces only (τ_i = z_{i−1} · f_i; their moments are not needed).
@@ -204,7 +209,9 @@ void rne_kernel(const Links& L, const vec3<T>& g, const Q& q, const QD& qd, cons
         f = rot(k1.ca, k1.sa, k1.ct0, k1.st0, f);
     }
     f = f + ws[i].F;
-    tau(i) = k.sa * f.y + k.ca * f.z;
+    T t = k.sa * f.y + k.ca * f.z;
+    if (k.has_armature) t += T(k.Ia) * T(qdd(i));
+    tau(i) = t;
   }
 }
 
@@ -266,6 +273,17 @@ class rne_fn : public stage_tag {
     run(q, qd, qdd, v);
     detail::check_result(v, q, qd, qdd, "rne");
     return v;
+  }
+
+  /// With applied forces (external wrenches, dynamics/wrench.hpp): v − Q_ext(q).
+  template <class Q, class QD, class QDD, applied_forces F>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
+                  const F& fx) const {
+    const auto v = (*this)(q, qd, qdd);
+    const auto Qx = fx.generalized_force(q);
+    using R = promote_t<typename decltype(v)::Scalar, typename decltype(Qx)::Scalar>;
+    vecN<R, N> out = v.template cast<R>() - Qx.template cast<R>();
+    return out;
   }
 
   /// Pipeline form: ξ = (q, q̇, q̈) → (q, v).

@@ -3,7 +3,7 @@
 /// rne, the mass matrix (CRBA), the bias and the holonomic forward dynamics of a kinematic
 /// tree (model/tree.hpp), as function objects generic over the scalar, with the same call
 /// forms as the chain versions: `rne(t)(q, qd, qdd)`, `mass_matrix(t)(q)`, `bias(t)(q, qd)`,
-/// `forward_dynamics(t)(q, qd, tau)`.
+/// and (dynamics/forward_dynamics.hpp, included at the end) `forward_dynamics(t)(q, qd, tau)`.
 ///
 /// The kernel is the optimisation of the reference algorithms (dynamics/reference.hpp: RBDA
 /// Tables 5.1 and 6.2), tested equal to them. What it changes: each body is computed in its
@@ -77,6 +77,7 @@ void tree_rne_kernel(const std::vector<tree_link<T>>& L, const vec3<T>& g, const
     const auto& k = L[i];
     auto& c = s[i];
     tau(i) = k.revolute ? c.m.z() : c.f.z();
+    if (k.has_armature) tau(i) += k.Ia * T(qdd(i));
     if (k.parent >= 0) {
       auto& pc = s[k.parent];
       const vec3<T> f = c.R * c.f;
@@ -136,6 +137,7 @@ Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> tree_crba_kernel(const std::vec
       j = L[j].parent;
       H(i, j) = H(j, i) = L[j].revolute ? nm.z() : f.z();
     }
+    if (L[i].has_armature) H(i, i) += L[i].Ia;
   }
   return H;
 }
@@ -188,6 +190,17 @@ class tree_rne_fn : public stage_tag {
       run(cast_links<T>());
     detail::check_overflow(v, "rne");
     return v;
+  }
+
+  /// With applied forces (external wrenches, dynamics/wrench.hpp): v − Q_ext(q).
+  template <class Q, class QD, class QDD, applied_forces F>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
+                  const F& fx) const {
+    const auto v = (*this)(q, qd, qdd);
+    const auto Qx = fx.generalized_force(q);
+    using R = promote_t<typename decltype(v)::Scalar, typename decltype(Qx)::Scalar>;
+    vecN<R, dynamic> out = v.template cast<R>() - Qx.template cast<R>();
+    return out;
   }
 
   /// Pipeline form: ξ = (q, q̇, q̈) → (q, v).
@@ -274,39 +287,7 @@ tree_bias_fn<S> bias(const tree<S>& t, rne_options o = {}) {
   return tree_bias_fn<S>(t, o);
 }
 
-/// Holonomic forward dynamics of a tree, q̈ = M⁻¹(τ − h), M by CRBA, solved by LDLᵀ.
-template <class S>
-class tree_forward_dynamics_fn : public stage_tag {
- public:
-  explicit tree_forward_dynamics_fn(const tree<S>& t, rne_options o = {}) : M_(t), rne_(t, o) {}
-
-  template <class Q>
-  double mass_matrix_condition(const Eigen::MatrixBase<Q>& q) const {
-    return condition_number(M_(q));
-  }
-
-  template <class Q, class QD, class TAU>
-  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
-                  const Eigen::MatrixBase<TAU>& tau) const {
-    using X = typename Q::Scalar;
-    using T = promote_t<S, X>;
-    detail::check_size(tau, rne_.dof(), "tau");
-    detail::check_finite(tau, "tau");
-    const vecN<T, dynamic> h = rne_(q, qd, vecN<X, dynamic>::Zero(q.size()));
-    const auto f = ldlt_factor<T, dynamic>(M_(q), "the mass matrix M(q)");
-    vecN<T, dynamic> qdd = f.solve(tau.template cast<T>() - h);
-    detail::check_overflow(qdd, "forward_dynamics");
-    return qdd;
-  }
-
- private:
-  tree_mass_matrix_fn<S> M_;
-  tree_rne_fn<S> rne_;
-};
-
-template <class S>
-tree_forward_dynamics_fn<S> forward_dynamics(const tree<S>& t, rne_options o = {}) {
-  return tree_forward_dynamics_fn<S>(t, o);
-}
-
 }  // namespace nhdyn
+
+// forward_dynamics(tree): the holonomic forward dynamics of chains and trees, in one place.
+#include "forward_dynamics.hpp"

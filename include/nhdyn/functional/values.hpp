@@ -44,4 +44,12 @@ struct constrained_forces {
   vecN<S, K> lambda;
 };
 
+/// Forces applied to the joints from outside, known at q: `f.generalized_force(q)` (n
+/// entries, the power they deliver is its dot product with q̇) — external wrenches
+/// (dynamics/wrench.hpp). The dynamics take one as an optional last argument: rne and the
+/// inverse dynamics subtract it (the actuators need that much less), the forward dynamics add
+/// it to τ. A type opts in by declaring `using applied_forces_tag = void;`.
+template <class F>
+concept applied_forces = requires { typename std::remove_cvref_t<F>::applied_forces_tag; };
+
 }  // namespace nhdyn

@@ -7,7 +7,9 @@
 ///     {"name": "paper5", "description": "…",                      (description optional)
 ///      "gravity": [gx, gy, gz],
 ///      "links": [{"joint": "revolute" | "prismatic", "alpha", "a", "theta", "d", "mass",
-///                 "com": [x, y, z], "inertia": [[Ixx,Ixy,Ixz],[Ixy,Iyy,Iyz],[Ixz,Iyz,Izz]]}, …],
+///                 "com": [x, y, z], "inertia": [[Ixx,Ixy,Ixz],[Ixy,Iyy,Iyz],[Ixz,Iyz,Izz]],
+///                 "armature", "friction": {"viscous", "coulomb"}         (optional, joint side)
+///                 | "motor": {"inertia", "gear", "viscous", "coulomb"}}, …],  (or motor side)
 ///      "validation": {"triangle_inequality": true},                (optional)
 ///      "constraint": {"type": "differential_drive", "x": 0, "y": 1, "heading": 2,
 ///                     "forward_offset": 0, "heading_sign": -1}}    (optional; 0-based joints)
@@ -29,6 +31,8 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "../constraints/constraint.hpp"
@@ -249,10 +253,53 @@ inline int joint_index(const json& j, const place& at, std::string_view f, int n
   return static_cast<int>(i);
 }
 
+/// A Coulomb value: one number c (±c) or [c⁺, c⁻].
+inline std::pair<double, double> coulomb_pair(const json& j, const place& at, std::string_view f) {
+  if (j.is_array()) {
+    if (j.size() != 2) throw model_error(at.field(f) + "expected a number or [positive, negative], got " + describe(j));
+    return {number(j[0], at, f, "[0]: "), number(j[1], at, f, "[1]: ")};
+  }
+  const double c = number(j, at, f);
+  return {c, -c};
+}
+
+/// A joint's drive, joint side ("armature", "friction": {"viscous", "coulomb"}) or motor side
+/// ("motor": {"inertia", "gear", "viscous", "coulomb"}, reflected: G²J_m, G²B, |G|Tc).
+template <class S>
+void read_drive(const json& j, const place& at, S& armature, joint_friction& friction) {
+  if (j.contains("motor") && (j.contains("armature") || j.contains("friction")))
+    throw model_error(at.field("motor") + "give the drive either motor side (\"motor\") or joint side "
+                                          "(\"armature\", \"friction\"), not both");
+  if (j.contains("armature")) armature = S(number(j["armature"], at, "armature"));
+  if (j.contains("friction")) {
+    const place f{at.prefix + ", friction"};
+    const json& o = j["friction"];
+    if (!o.is_object()) throw model_error(at.field("friction") + "expected an object, got " + describe(o));
+    check_keys(o, {"viscous", "coulomb"}, {}, f.prefix + ", ", "friction");
+    if (o.contains("viscous")) friction.viscous = number(o["viscous"], f, "viscous");
+    if (o.contains("coulomb")) std::tie(friction.coulomb_pos, friction.coulomb_neg) = coulomb_pair(o["coulomb"], f, "coulomb");
+  }
+  if (j.contains("motor")) {
+    const place m{at.prefix + ", motor"};
+    const json& o = j["motor"];
+    if (!o.is_object()) throw model_error(at.field("motor") + "expected an object, got " + describe(o));
+    check_keys(o, {"inertia", "gear", "viscous", "coulomb"}, {"gear"}, m.prefix + ", ", "motor");
+    const double G = number(o["gear"], m, "gear"), aG = std::abs(G);
+    if (G == 0) throw model_error(m.field("gear") + "a gear ratio of 0 connects no motor");
+    if (o.contains("inertia")) armature = S(G * G * number(o["inertia"], m, "inertia"));
+    if (o.contains("viscous")) friction.viscous = G * G * number(o["viscous"], m, "viscous");
+    if (o.contains("coulomb")) {
+      const auto [p, n] = coulomb_pair(o["coulomb"], m, "coulomb");
+      friction.coulomb_pos = aG * p;
+      friction.coulomb_neg = aG * n;
+    }
+  }
+}
+
 template <class S>
 link<S> read_link(const json& j, const place& at) {
   if (!j.is_object()) throw model_error(at.prefix + ": expected an object, got " + describe(j));
-  check_keys(j, {"joint", "alpha", "a", "theta", "d", "mass", "com", "inertia"},
+  check_keys(j, {"joint", "alpha", "a", "theta", "d", "mass", "com", "inertia", "armature", "friction", "motor"},
              {"joint", "alpha", "a", "theta", "d", "mass", "com", "inertia"}, at.prefix + ", ", "the link");
   link<S> L;
   const auto joint = string_field(j["joint"], at, "joint");
@@ -266,6 +313,7 @@ link<S> read_link(const json& j, const place& at) {
   L.mass = S(number(j["mass"], at, "mass"));
   L.com = vector3<S>(j["com"], at, "com");
   L.inertia = matrix3<S>(j["inertia"], at, "inertia");
+  read_drive(j, at, L.armature, L.friction);
   return L;
 }
 
@@ -358,7 +406,7 @@ model<S> load_model(const std::filesystem::path& path) {
 }
 
 /// The names of the presets `preset` knows.
-inline std::vector<std::string> preset_names() { return {"paper5", "puma560"}; }
+inline std::vector<std::string> preset_names() { return {"paper5", "puma560", "puma560_motors"}; }
 
 /// A preset by name ("paper5" with its constraint, "puma560"); throws model_error otherwise.
 template <class S = double>
@@ -377,6 +425,10 @@ model<S> preset(std::string_view name) {
             "Unimation Puma 560, standard DH, rigid-body parameters of P. Corke's Robotics Toolbox "
             "mdl_puma560.m (parameters of 8/95: Corke & Armstrong-Helouvry, ICRA 1994); no motor inertia, gearing or friction; "
             "links 1 and 3 violate the triangle inequality as published"};
+  if (name == "puma560_motors")
+    return {presets::puma560_motors<S>().dynamic_size(), std::nullopt,
+            "puma560 with its drives from the same file: armature G^2 Jm, viscous friction G^2 B and "
+            "Coulomb friction |G| Tc per joint (joint side); rne adds the armature, friction is a stage"};
   std::string known;
   for (const auto& n : preset_names()) known += (known.empty() ? "" : ", ") + n;
   throw model_error("unknown preset '" + std::string(name) + "' (known: " + known + ")");
@@ -419,9 +471,19 @@ ordered_json to_json(const chain<S, N>& ch, const differential_drive<S, N>* c = 
   for (const auto& L : ch) {
     ordered_json I = ordered_json::array();
     for (int r = 0; r < 3; ++r) I.push_back({d(L.inertia(r, 0)), d(L.inertia(r, 1)), d(L.inertia(r, 2))});
-    links.push_back({{"joint", to_string(L.joint)}, {"alpha", d(L.alpha)}, {"a", d(L.a)},
-                     {"theta", d(L.theta)}, {"d", d(L.d)}, {"mass", d(L.mass)},
-                     {"com", {d(L.com(0)), d(L.com(1)), d(L.com(2))}}, {"inertia", I}});
+    ordered_json l = {{"joint", to_string(L.joint)}, {"alpha", d(L.alpha)}, {"a", d(L.a)},
+                      {"theta", d(L.theta)}, {"d", d(L.d)}, {"mass", d(L.mass)},
+                      {"com", {d(L.com(0)), d(L.com(1)), d(L.com(2))}}, {"inertia", I}};
+    if (d(L.armature) != 0) l["armature"] = d(L.armature);
+    if (L.friction != joint_friction{}) {
+      const auto& f = L.friction;
+      l["friction"] = {{"viscous", f.viscous}};
+      if (f.coulomb_neg == -f.coulomb_pos)
+        l["friction"]["coulomb"] = f.coulomb_pos;
+      else
+        l["friction"]["coulomb"] = {f.coulomb_pos, f.coulomb_neg};
+    }
+    links.push_back(l);
   }
   j["links"] = links;
   return j;

@@ -184,13 +184,46 @@ inline robot_constraint read_robot_constraint(const json& c, const tree<double>&
 }
 }  // namespace detail
 
+namespace detail {
+/// The tree with the drives a robot file's "drives" gives by joint name (armature, friction;
+/// or motor side, as in JSON models), over what the URDF's <dynamics> said.
+inline tree<double> with_drives(const tree<double>& t, const json& d, const place& top) {
+  if (!d.is_object()) throw model_error(top.field("drives") + "expected an object {joint name: drive}, got " + describe(d));
+  std::vector<body<double>> bodies = t.bodies();
+  for (auto it = d.begin(); it != d.end(); ++it) {
+    const place at{top.prefix + ", drives, joint '" + it.key() + "'"};
+    int i = -1;
+    for (int k = 0; k < t.dof(); ++k)
+      if (t[k].joint_name == it.key()) i = k;
+    if (i < 0) {
+      std::string known;
+      for (const auto& b : t) known += (known.empty() ? "" : ", ") + b.joint_name;
+      throw model_error(at.prefix + ": no movable joint of that name (movable joints: " + known + ")");
+    }
+    if (!it.value().is_object()) throw model_error(at.prefix + ": expected an object, got " + describe(it.value()));
+    check_keys(it.value(), {"armature", "friction", "motor"}, {}, at.prefix + ", ", "a drive");
+    auto& b = bodies[std::size_t(i)];
+    joint_friction f = b.friction_law();
+    read_drive(it.value(), at, b.armature, f);
+    b.damping = f.viscous;
+    b.friction = f.coulomb_pos;
+    b.friction_negative = f.coulomb_neg == -f.coulomb_pos ? std::nullopt : std::optional<double>(f.coulomb_neg);
+  }
+  try {
+    return tree<double>(std::move(bodies), t.gravity(), t.name(), t.validation_policy(), t.root_name(), t.frames());
+  } catch (const model_error& e) {
+    throw model_error(top.field("drives") + e.what());
+  }
+}
+}  // namespace detail
+
 /// The robot file's text; `path` locates the URDF (relative paths from its folder) and names
 /// the file in messages.
 inline robot_model parse_robot_file(const std::string& text, const std::string& path, urdf_options opt = {}) {
   const std::string where = "robot file '" + path + "': ";
   const json j = parse_strict(text, where);
   if (!j.is_object()) throw model_error(where + "expected a JSON object, got " + detail::describe(j));
-  detail::check_keys(j, {"name", "description", "urdf", "gravity", "base", "constraint"}, {"urdf"}, where,
+  detail::check_keys(j, {"name", "description", "urdf", "gravity", "base", "drives", "constraint"}, {"urdf"}, where,
                      "a robot file");
   const detail::place top{"robot file '" + path + "'"};
   if (!j["urdf"].is_string()) throw model_error(top.field("urdf") + "expected a path, got " + detail::describe(j["urdf"]));
@@ -208,6 +241,7 @@ inline robot_model parse_robot_file(const std::string& text, const std::string& 
   }
   robot_model out{load_urdf(urdf_path.string(), opt), std::nullopt, ""};
   out.name = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : out.model.name();
+  if (j.contains("drives")) out.model = detail::with_drives(out.model, j["drives"], top);
   if (j.contains("constraint")) out.constraint = detail::read_robot_constraint(j["constraint"], out.model, top, opt);
   return out;
 }

@@ -46,6 +46,7 @@ mat3<T> dh_rotation(const dh_link<S>& k, const T& ct, const T& st) {
 template <class S, int N = dynamic>
 class kinematics {
  public:
+  using scalar_type = S;
   explicit kinematics(const chain<S, N>& c) : links_(detail::make_dh_links(c)), n_(c.dof()) {}
   int dof() const { return n_; }
 

@@ -20,6 +20,7 @@ namespace nhdyn {
 template <class S>
 class tree_kinematics {
  public:
+  using scalar_type = S;
   explicit tree_kinematics(const tree<S>& t) : tree_(t), links_(detail::make_tree_links(t)), n_(t.dof()) {}
   int dof() const { return n_; }
   const tree<S>& model() const { return tree_; }

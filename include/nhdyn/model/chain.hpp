@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -44,6 +45,20 @@ inline std::string link_where(const std::string& chain_name, std::size_t i) {
   return os.str();
 }
 
+/// What is wrong with a joint's friction law, if anything: not finite, or not dissipative
+/// (viscous < 0, coulomb_pos < 0 or coulomb_neg > 0).
+inline std::optional<std::string> friction_problem(const joint_friction& f) {
+  if (!std::isfinite(f.viscous) || !std::isfinite(f.coulomb_pos) || !std::isfinite(f.coulomb_neg))
+    return "is not finite (NaN or Inf)";
+  std::ostringstream os;
+  if (f.viscous < 0) os << "viscous coefficient " << f.viscous << " is negative";
+  else if (f.coulomb_pos < 0) os << "Coulomb force at positive speed " << f.coulomb_pos << " is negative";
+  else if (f.coulomb_neg > 0) os << "Coulomb force at negative speed " << f.coulomb_neg << " is positive";
+  else return std::nullopt;
+  os << " (friction must oppose motion)";
+  return os.str();
+}
+
 /// Throws model_error if link i is not physical. Checks on the double value of each
 /// parameter (for intervals: the midpoint; enclosures are the caller's business).
 template <class S>
@@ -69,6 +84,13 @@ void validate_link(const link<S>& L, const std::string& chain_name, std::size_t 
     os << where("mass") << "is negative (" << value_of(L.mass) << " kg)";
     throw model_error(os.str());
   }
+  finite(L.armature, "armature");
+  if (value_of(L.armature) < 0) {
+    std::ostringstream os;
+    os << where("armature") << "is negative (" << value_of(L.armature) << ")";
+    throw model_error(os.str());
+  }
+  if (auto why = friction_problem(L.friction)) throw model_error(where("friction") + *why);
   Eigen::Matrix3d I;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) I(r, c) = value_of(L.inertia(r, c));

@@ -33,6 +33,8 @@ struct dh_link {
   S p0[3] = {S(0), S(0), S(0)};                ///< p_i at d = d0: (a, d0 sin α, d0 cos α)
   S hs[3] = {S(0), S(0), S(0)};                ///< h
   S Is[6] = {S(0), S(0), S(0), S(0), S(0), S(0)};  ///< I_o: xx, yy, zz, xy, xz, yz
+  S Ia{0};                    ///< the joint's armature (joint-side rotor inertia)
+  bool has_armature = false;  ///< Ia ≠ 0
 };
 
 template <class S>
@@ -80,6 +82,8 @@ dh_link<S> make_dh_link(const link<S>& L) {
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) zero = zero && is_exact_zero(L.inertia(r, c));
   k.has_inertia = !zero;
+  k.Ia = L.armature;
+  k.has_armature = !is_exact_zero(L.armature);
   return k;
 }
 

@@ -63,15 +63,24 @@ struct body {
   vec3<S> com = vec3<S>::Zero();       ///< centre of mass in the body frame [m]
   mat3<S> inertia = mat3<S>::Zero();   ///< about the centre of mass, body-frame axes [kg·m²]
   joint_limits limits{};
-  double damping = 0;   ///< URDF `<dynamics damping>` [N·m·s/rad or N·s/m]; kept
-  double friction = 0;  ///< URDF `<dynamics friction>` [N·m or N]; kept
+  double damping = 0;   ///< viscous friction: URDF `<dynamics damping>` [N·m·s/rad or N·s/m]
+  double friction = 0;  ///< Coulomb friction: URDF `<dynamics friction>` [N·m or N]
   std::optional<mimic_info> mimic{};
+  /// Joint-side rotor inertia of the drive, G²·J_m [kg·m² or kg]: adds armature·q̈_i to τ_i and
+  /// to M's diagonal (URDF has no field for it; JSON models and robot files do).
+  S armature{0};
+  /// The Coulomb force at q̇ < 0 when it is not −friction (an asymmetric law, as Corke's Puma).
+  std::optional<double> friction_negative{};
+
+  /// The friction law the friction stages use (dynamics/friction.hpp).
+  joint_friction friction_law() const { return {damping, friction, friction_negative.value_or(-friction)}; }
 
   template <class U>
   body<U> cast() const {
     return {name,   joint_name, parent, joint, continuous, R_PJ.template cast<U>(), p_PJ.template cast<U>(),
             axis.template cast<U>(), R_JB.template cast<U>(), p_JB.template cast<U>(), U(mass),
-            com.template cast<U>(), inertia.template cast<U>(), limits, damping, friction, mimic};
+            com.template cast<U>(), inertia.template cast<U>(), limits, damping, friction, mimic, U(armature),
+            friction_negative};
   }
 };
 
@@ -241,6 +250,9 @@ class tree {
     if (auto why = detail::inertia_problem(value_of(b.mass), detail::value_matrix(b.inertia),
                                            validation_.positive_semidefinite, validation_.triangle_inequality))
       throw model_error(where + *why);
+    if (!is_finite_scalar(b.armature) || value_of(b.armature) < 0)
+      throw model_error(where + "armature " + std::to_string(value_of(b.armature)) + " is not a finite number >= 0");
+    if (auto why = detail::friction_problem(b.friction_law())) throw model_error(where + "friction " + *why);
   }
 
   std::vector<body<S>> bodies_{};
@@ -301,6 +313,10 @@ tree<S> as_tree(const chain<S, N>& c) {
     b.com = L.com;
     b.inertia = L.inertia;
     b.continuous = L.joint == joint_type::revolute;
+    b.armature = L.armature;
+    b.damping = L.friction.viscous;
+    b.friction = L.friction.coulomb_pos;
+    if (L.friction.coulomb_neg != -L.friction.coulomb_pos) b.friction_negative = L.friction.coulomb_neg;
     out.push_back(std::move(b));
   }
   validation v = c.validation_policy();

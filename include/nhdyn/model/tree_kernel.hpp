@@ -44,11 +44,14 @@ struct tree_link {
   mat3<S> Io;  ///< rotational inertia about K_i's origin, K_i's axes
   mat3<S> R_KB;  ///< the body frame's axes in K_i
   vec3<S> p_KB;  ///< the body frame's origin in K_i
+  S Ia{0};       ///< the joint's armature (joint-side rotor inertia)
+  bool has_armature = false;
 
   template <class U>
   tree_link<U> cast() const {
     return {parent, revolute, has_inertia, R.template cast<U>(), p.template cast<U>(), U(m),
-            h.template cast<U>(), Io.template cast<U>(), R_KB.template cast<U>(), p_KB.template cast<U>()};
+            h.template cast<U>(), Io.template cast<U>(), R_KB.template cast<U>(), p_KB.template cast<U>(),
+            U(Ia), has_armature};
   }
 };
 
@@ -79,6 +82,8 @@ std::vector<tree_link<S>> make_tree_links(const tree<S>& t) {
     k.h = b.mass * c;
     k.Io = k.R_KB * b.inertia * k.R_KB.transpose() + b.mass * (c.dot(c) * mat3<S>::Identity() - c * c.transpose());
     k.has_inertia = value_of(b.mass) != 0 || detail::value_matrix(b.inertia).cwiseAbs().maxCoeff() != 0;
+    k.Ia = b.armature;
+    k.has_armature = !is_exact_zero(b.armature);
   }
   return out;
 }

@@ -14,6 +14,10 @@
 ///   motor inertia Jm, gear ratios G and friction B, Tc that file adds. As published, links 1 and 3 violate the
 ///   triangle inequality of principal moments, so this preset is built with
 ///   `validation.triangle_inequality = false` (see model/chain.hpp).
+/// - `puma560_motors`: the same arm with the drives that file adds (`puma560_drives`): each
+///   joint's armature G²·J_m, viscous friction G²·B and Coulomb friction |G|·Tc⁺, |G|·Tc⁻,
+///   joint side. rne gives the rigid body plus armature; `rne(p) + friction(p)` is what the
+///   toolbox's own rne computes (its tests' values at qn reproduce: tests/test_drives.cpp).
 #include <numbers>
 #include <type_traits>
 
@@ -98,6 +102,33 @@ chain<S, 6> puma560() {
       {R, S(0), S(0), S(0), S(0), S(0.09), c(0, 0, 0.032), I(0.15e-3, 0.15e-3, 0.04e-3)},
   }};
   return chain<S, 6>(L, vec3<S>(S(0), S(0), S(-9.81)), "puma560", validation{false});
+}
+
+/// The Puma 560's drives as Corke's toolbox publishes them (mdl_puma560.m; Puma560.py of the
+/// Python toolbox), motor side: J_m [kg·m²], gear ratio G (signed: the motor turns −G times
+/// the joint for G < 0), viscous B [N·m·s/rad] and Coulomb Tc⁺, Tc⁻ [N·m] at the motor.
+struct puma560_drives {
+  static constexpr std::array<double, 6> Jm{200e-6, 200e-6, 200e-6, 33e-6, 33e-6, 33e-6};
+  static constexpr std::array<double, 6> G{-62.6111, 107.815, -53.7063, 76.0364, 71.923, 76.686};
+  static constexpr std::array<double, 6> B{1.48e-3, 0.817e-3, 1.38e-3, 71.2e-6, 82.6e-6, 36.7e-6};
+  static constexpr std::array<double, 6> Tc_pos{0.395, 0.126, 0.132, 11.2e-3, 9.26e-3, 3.96e-3};
+  static constexpr std::array<double, 6> Tc_neg{-0.435, -0.071, -0.105, -16.9e-3, -14.5e-3, -10.5e-3};
+};
+
+/// puma560 with its drives reflected to the joints: armature G²J_m, friction G²B, |G|Tc.
+template <class S = double>
+chain<S, 6> puma560_motors() {
+  const chain<S, 6> arm = puma560<S>();
+  std::array<link<S>, 6> L;
+  for (int i = 0; i < 6; ++i) {
+    using D = puma560_drives;
+    const double G = D::G[std::size_t(i)], aG = G < 0 ? -G : G;
+    L[std::size_t(i)] = arm[i];
+    L[std::size_t(i)].armature = S(G * G * D::Jm[std::size_t(i)]);
+    L[std::size_t(i)].friction = {G * G * D::B[std::size_t(i)], aG * D::Tc_pos[std::size_t(i)],
+                                  aG * D::Tc_neg[std::size_t(i)]};
+  }
+  return chain<S, 6>(L, arm.gravity(), "puma560_motors", validation{false});
 }
 
 }  // namespace nhdyn::presets
