@@ -1,0 +1,383 @@
+/// \file python/nhdyn_module.cpp
+/// The Python module `nhdyn` (pybind11): the library's models and dynamics on NumPy arrays,
+/// functional as in C++ — `nhdyn.rne(model)` returns a callable — and batched: every callable
+/// takes one state (1-D arrays) or many (2-D arrays, one state per row), the rows computed in
+/// C++ with the GIL released, optionally on several threads. docs/python.md is the guide.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <nhdyn/io/json.hpp>
+#include <nhdyn/nhdyn.hpp>
+#include <optional>
+#include <string>
+#include <thread>
+#include <variant>
+#include <vector>
+#if NHDYN_PY_URDF
+#include <nhdyn/io/robot_file.hpp>
+#include <nhdyn/io/urdf.hpp>
+#endif
+
+namespace py = pybind11;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+namespace {
+
+/// A loaded model: a DH chain (with a differential drive or not) or a tree (with any base
+/// constraint or not).
+struct model {
+  std::string name, source;
+  std::optional<nhdyn::chain<double>> chain;
+  std::optional<nhdyn::differential_drive<double>> chain_constraint;
+  std::optional<nhdyn::tree<double>> tree;
+  std::optional<nhdyn::base_constraint> tree_constraint;
+  std::vector<std::string> joints, eta;
+  int dof() const { return int(joints.size()); }
+  int m() const { return int(eta.size()); }
+  bool constrained() const { return chain_constraint || tree_constraint; }
+
+  /// constrained(model, c) or holonomic(model), as the tool's dispatch.
+  template <class Constrained, class Holonomic>
+  auto dispatch(const Constrained& constrained_fn, const Holonomic& holonomic_fn) const {
+    if (tree) {
+      if (tree_constraint)
+        return std::visit([&](const auto& c) { return constrained_fn(*tree, c); }, *tree_constraint);
+      return holonomic_fn(*tree);
+    }
+    if (chain_constraint) return constrained_fn(*chain, *chain_constraint);
+    return holonomic_fn(*chain);
+  }
+};
+
+bool ends_with_urdf(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return s.size() > 5 && s.compare(s.size() - 5, 5, ".urdf") == 0;
+}
+bool is_robot_file(const std::string& spec) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(spec, ec)) return false;
+  std::ifstream in(spec);
+  const auto j = nlohmann::json::parse(in, nullptr, false);
+  return j.is_object() && j.contains("urdf");
+}
+
+std::shared_ptr<model> load(const std::string& spec, bool strict) {
+  auto out = std::make_shared<model>();
+  out->source = spec;
+  const bool urdf = ends_with_urdf(spec), robot = !urdf && is_robot_file(spec);
+  if (urdf || robot) {
+#if NHDYN_PY_URDF
+    nhdyn::io::urdf_options o;
+    o.strict = strict;
+    if (robot) {
+      auto r = nhdyn::io::load_robot_file(spec, o);
+      out->name = r.name;
+      out->eta = r.eta_names();
+      out->tree = std::move(r.model);
+      out->tree_constraint = r.constraint;
+    } else {
+      out->tree = nhdyn::io::load_urdf(spec, o);
+      out->name = out->tree->name();
+    }
+    out->joints = out->tree->joint_names();
+    if (!robot) out->eta = out->joints;
+    return out;
+#else
+    throw nhdyn::model_error(spec + ": this nhdyn module was built without URDF support (liburdfdom-dev, libtinyxml2-dev)");
+#endif
+  }
+  (void)strict;
+  auto m = nhdyn::io::load<double>(spec);
+  out->name = m.chain.name();
+  for (int i = 0; i < m.chain.dof(); ++i) out->joints.push_back("joint" + std::to_string(i + 1));
+  out->eta = m.constraint ? m.constraint->eta_names(out->joints) : out->joints;
+  out->chain = std::move(m.chain);
+  out->chain_constraint = m.constraint;
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// Batched callables
+// ---------------------------------------------------------------------------------------
+
+/// One output array of a callable: a vector of `rows` entries, or a rows × cols matrix.
+struct output {
+  std::string name;
+  int rows = 0, cols = 0;  // cols 0: a vector
+  int size() const { return cols ? rows * cols : rows; }
+};
+
+/// A function of k vectors (sizes `args`) with outputs `outs`, callable on one state or a
+/// batch. `f(in, out)`: in[j] points at argument j's entries, out[o] at output o's storage
+/// (row-major for a matrix).
+class batch_function {
+ public:
+  using kernel = std::function<void(const std::vector<const double*>&, const std::vector<double*>&)>;
+  batch_function(std::string name, std::vector<std::pair<std::string, int>> args, std::vector<output> outs, kernel f)
+      : name_(std::move(name)), args_(std::move(args)), outs_(std::move(outs)), f_(std::move(f)) {}
+
+  py::object call(const py::args& a, int threads) const {
+    if (a.size() != args_.size()) {
+      std::string want;
+      for (const auto& x : args_) want += (want.empty() ? "" : ", ") + x.first;
+      throw py::type_error(name_ + "(" + want + "): takes " + std::to_string(args_.size()) + " arrays, got " +
+                           std::to_string(a.size()));
+    }
+    std::vector<py::array_t<double, py::array::c_style>> in;
+    py::ssize_t batch = -1;  // -1: one state (1-D arrays)
+    for (std::size_t j = 0; j < args_.size(); ++j) {
+      const auto& [arg, n] = args_[j];
+      py::array raw = py::array::ensure(a[j]);
+      if (!raw) throw py::type_error(name_ + ": '" + arg + "' is not an array of numbers");
+      const char kind = raw.dtype().kind();
+      if (kind != 'f' && kind != 'i' && kind != 'u')
+        throw py::type_error(name_ + ": '" + arg + "' has dtype " + std::string(py::str(raw.dtype())) +
+                             "; real numbers (float or int arrays, converted to float64) only");
+      auto x = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(raw);
+      if (x.ndim() != 1 && x.ndim() != 2)
+        throw py::value_error(name_ + ": '" + arg + "' must be 1-D (one state) or 2-D (one state per row), not " +
+                              std::to_string(x.ndim()) + "-D");
+      const py::ssize_t len = x.shape(x.ndim() - 1), rows = x.ndim() == 2 ? x.shape(0) : -1;
+      if (len != n)
+        throw py::value_error(name_ + ": '" + arg + "' has " + std::to_string(len) + " entries; the model needs " +
+                              std::to_string(n));
+      if (j == 0) batch = rows;
+      else if (rows != batch)
+        throw py::value_error(name_ + ": '" + arg + "' is " + (rows < 0 ? "1-D" : std::to_string(rows) + " rows") + " but '" +
+                              args_[0].first + "' is " + (batch < 0 ? "1-D" : std::to_string(batch) + " rows"));
+      in.push_back(std::move(x));
+    }
+    const py::ssize_t count = batch < 0 ? 1 : batch;
+    std::vector<py::array_t<double>> out;
+    for (const auto& o : outs_) {
+      std::vector<py::ssize_t> shape;
+      if (batch >= 0) shape.push_back(batch);
+      shape.push_back(o.rows);
+      if (o.cols) shape.push_back(o.cols);
+      out.emplace_back(shape);
+    }
+    std::vector<const double*> ip;
+    for (const auto& x : in) ip.push_back(x.data());
+    std::vector<double*> op;
+    for (auto& x : out) op.push_back(x.mutable_data());
+    run(ip, op, count, threads);
+    if (out.size() == 1) return std::move(out[0]);
+    py::tuple t(out.size());
+    for (std::size_t o = 0; o < out.size(); ++o) t[o] = std::move(out[o]);
+    return t;
+  }
+
+  std::string signature() const {
+    std::string s = name_ + "(";
+    for (std::size_t j = 0; j < args_.size(); ++j)
+      s += (j ? ", " : "") + args_[j].first + "[" + std::to_string(args_[j].second) + "]";
+    s += ") -> ";
+    for (std::size_t o = 0; o < outs_.size(); ++o)
+      s += (o ? ", " : "") + outs_[o].name + "[" + std::to_string(outs_[o].rows) + (outs_[o].cols ? "x" + std::to_string(outs_[o].cols) : "") + "]";
+    return s;
+  }
+
+ private:
+  /// Rows [0, count): with the GIL released, on `threads` threads (≤ 1: this one). The first
+  /// error (by row) is rethrown, naming the row for a batch.
+  void run(const std::vector<const double*>& in, const std::vector<double*>& out, py::ssize_t count, int threads) const {
+    const bool batch = count > 1 || threads > 1;
+    std::vector<std::exception_ptr> errors(std::size_t(std::max(1, threads)));
+    std::vector<py::ssize_t> error_row(errors.size(), -1);
+    const auto rows = [&](int worker, py::ssize_t begin, py::ssize_t end) {
+      std::vector<const double*> ip(in.size());
+      std::vector<double*> op(out.size());
+      for (py::ssize_t r = begin; r < end; ++r) {
+        for (std::size_t j = 0; j < in.size(); ++j) ip[j] = in[j] + r * args_[j].second;
+        for (std::size_t o = 0; o < out.size(); ++o) op[o] = out[o] + r * outs_[o].size();
+        try {
+          f_(ip, op);
+        } catch (...) {
+          errors[std::size_t(worker)] = std::current_exception();
+          error_row[std::size_t(worker)] = r;
+          return;
+        }
+      }
+    };
+    {
+      py::gil_scoped_release release;
+      const int t = int(std::min<py::ssize_t>(std::max(1, threads), count));
+      if (t <= 1) {
+        rows(0, 0, count);
+      } else {
+        std::vector<std::thread> pool;
+        for (int w = 0; w < t; ++w) pool.emplace_back(rows, w, count * w / t, count * (w + 1) / t);
+        for (auto& th : pool) th.join();
+      }
+    }
+    for (std::size_t w = 0; w < errors.size(); ++w)
+      if (errors[w]) {
+        if (!batch) std::rethrow_exception(errors[w]);
+        try {
+          std::rethrow_exception(errors[w]);
+        } catch (const nhdyn::model_error& e) {
+          throw nhdyn::model_error("row " + std::to_string(error_row[w]) + ": " + e.what());
+        } catch (const nhdyn::input_error& e) {
+          throw nhdyn::input_error("row " + std::to_string(error_row[w]) + ": " + e.what());
+        } catch (const nhdyn::numerical_error& e) {
+          throw nhdyn::numerical_error("row " + std::to_string(error_row[w]) + ": " + e.what());
+        }
+      }
+  }
+
+  std::string name_;
+  std::vector<std::pair<std::string, int>> args_;
+  std::vector<output> outs_;
+  kernel f_;
+};
+
+using rowmajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using cmap = Eigen::Map<const VectorXd>;
+using vmap = Eigen::Map<VectorXd>;
+
+template <class Model>
+batch_function rne_of(const Model& mdl) {
+  const int n = mdl.dof();
+  const auto f = nhdyn::rne(mdl);
+  return {"rne", {{"q", n}, {"qd", n}, {"qdd", n}}, {{"tau", n}}, [f, n](const auto& in, const auto& out) {
+            vmap(out[0], n) = f(cmap(in[0], n), cmap(in[1], n), cmap(in[2], n));
+          }};
+}
+template <class Model>
+batch_function mass_matrix_of(const Model& mdl) {
+  const int n = mdl.dof();
+  const auto f = nhdyn::mass_matrix(mdl);
+  return {"mass_matrix", {{"q", n}}, {{"M", n, n}}, [f, n](const auto& in, const auto& out) {
+            Eigen::Map<rowmajor>(out[0], n, n) = f(cmap(in[0], n));
+          }};
+}
+template <class Model>
+batch_function bias_of(const Model& mdl) {
+  const int n = mdl.dof();
+  const auto f = nhdyn::bias(mdl);
+  return {"bias", {{"q", n}, {"qd", n}}, {{"h", n}}, [f, n](const auto& in, const auto& out) {
+            vmap(out[0], n) = f(cmap(in[0], n), cmap(in[1], n));
+          }};
+}
+template <class Model>
+batch_function holonomic_fd_of(const Model& mdl) {
+  const int n = mdl.dof();
+  const auto f = nhdyn::forward_dynamics(mdl);
+  return {"forward_dynamics", {{"q", n}, {"qd", n}, {"tau", n}}, {{"qdd", n}}, [f, n](const auto& in, const auto& out) {
+            vmap(out[0], n) = f(cmap(in[0], n), cmap(in[1], n), cmap(in[2], n));
+          }};
+}
+template <class Model, class C>
+batch_function nh_id_of(const Model& mdl, const C& c) {
+  const int n = mdl.dof(), k = c.m();
+  const auto f = nhdyn::inverse_dynamics(mdl, c);
+  return {"inverse_dynamics", {{"q", n}, {"eta", k}, {"eta_dot", k}}, {{"tau", k}}, [f, n, k](const auto& in, const auto& out) {
+            vmap(out[0], k) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], k)), VectorXd(cmap(in[2], k)));
+          }};
+}
+template <class Model, class C>
+batch_function nh_id_forces_of(const Model& mdl, const C& c) {
+  const int n = mdl.dof(), m = c.m(), k = c.k();
+  const auto f = nhdyn::inverse_dynamics_with_forces(mdl, c);
+  return {"inverse_dynamics_with_forces", {{"q", n}, {"eta", m}, {"eta_dot", m}}, {{"tau", m}, {"lambda", k}},
+          [f, n, m, k](const auto& in, const auto& out) {
+            const auto r = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)), VectorXd(cmap(in[2], m)));
+            vmap(out[0], m) = r.tau;
+            vmap(out[1], k) = r.lambda;
+          }};
+}
+template <class Model, class C>
+batch_function nh_fd_of(const Model& mdl, const C& c) {
+  const int n = mdl.dof(), m = c.m();
+  const auto f = nhdyn::nh_forward_dynamics(mdl, c);
+  return {"forward_dynamics", {{"q", n}, {"eta", m}, {"tau", m}}, {{"eta_dot", m}}, [f, n, m](const auto& in, const auto& out) {
+            vmap(out[0], m) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)), VectorXd(cmap(in[2], m)));
+          }};
+}
+
+batch_function not_constrained(const model& m, const char* what) {
+  throw nhdyn::model_error("model '" + m.name + "' has no constraint: " + what + " needs one (use rne)");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(nhdyn, mod) {
+  mod.doc() = R"(nhdyn: dynamics of manipulators and nonholonomic mobile manipulators.
+
+Functional, as the C++ library: nhdyn.rne(model) returns a callable f(q, qd, qdd) -> tau.
+Every callable takes one state (1-D float64 arrays) or a batch (2-D arrays, one state per
+row; the rows are computed in C++ with the GIL released, on `threads` threads). Integer and
+float32 arrays are converted to float64; other dtypes are refused. SI units, radians.
+See docs/python.md.)";
+
+  py::register_exception<nhdyn::model_error>(mod, "ModelError", PyExc_ValueError);
+  py::register_exception<nhdyn::input_error>(mod, "InputError", PyExc_ValueError);
+  py::register_exception<nhdyn::numerical_error>(mod, "NumericalError", PyExc_ArithmeticError);
+
+  py::class_<model, std::shared_ptr<model>>(mod, "Model", "A robot model: a DH chain or a kinematic tree, with its constraint if any.")
+      .def_property_readonly("name", [](const model& m) { return m.name; }, "the model's name")
+      .def_property_readonly("dof", &model::dof, "n, the number of joint coordinates q")
+      .def_property_readonly("joints", [](const model& m) { return m.joints; }, "joint names in q order")
+      .def_property_readonly("eta", [](const model& m) { return m.eta; },
+                             "names of eta's entries (the actuator velocities); the joint names when unconstrained")
+      .def_property_readonly("m", &model::m, "len(eta)")
+      .def_property_readonly("k", [](const model& m) { return m.dof() - m.m(); }, "number of constraints")
+      .def_property_readonly("constrained", &model::constrained, "whether the model has a nonholonomic constraint")
+      .def_property_readonly("source", [](const model& m) { return m.source; }, "what it was loaded from")
+      .def("__repr__", [](const model& m) {
+        return "<nhdyn.Model '" + m.name + "': dof " + std::to_string(m.dof()) + ", k " + std::to_string(m.dof() - m.m()) + ">";
+      });
+
+  py::class_<batch_function>(mod, "Function", "A dynamics function of a model: call it on arrays.")
+      .def("__call__", &batch_function::call, py::arg("threads") = 1,
+           "f(*arrays, threads=1): one state (1-D arrays) or one per row (2-D arrays, same number of rows)")
+      .def_property_readonly("signature", &batch_function::signature, "argument and result names and sizes")
+      .def("__repr__", [](const batch_function& f) { return "<nhdyn.Function " + f.signature() + ">"; });
+
+  mod.def("presets", [] { return nhdyn::io::preset_names(); }, "The names nhdyn.load knows without a file.");
+  mod.def("load", &load, py::arg("spec"), py::arg("strict") = false,
+          R"(load(spec, strict=False) -> Model
+
+spec: a preset name (nhdyn.presets()), a JSON model file, a URDF file (*.urdf) or a robot
+file (JSON with a "urdf" key: a URDF on a wheeled base with its constraint). strict: a
+non-physical URDF inertia is an error instead of a warning on stderr. Raises ModelError
+with the file, link and field at fault.)");
+  mod.def("rne", [](const model& m) { return m.dispatch([](const auto& x, const auto&) { return rne_of(x); }, [](const auto& x) { return rne_of(x); }); },
+          py::arg("model"),
+          R"(rne(model) -> f(q, qd, qdd) -> tau
+
+The holonomic recursive Newton-Euler inverse dynamics tau = M(q) qdd + C(q, qd) qd + g(q)
+(+ armature qdd), n entries each [rad, rad/s, rad/s^2 or m, m/s, m/s^2 -> N m or N]. For a
+constrained model: of its stationary robot (all n joints).)");
+  mod.def("mass_matrix", [](const model& m) { return m.dispatch([](const auto& x, const auto&) { return mass_matrix_of(x); }, [](const auto& x) { return mass_matrix_of(x); }); },
+          py::arg("model"), "mass_matrix(model) -> f(q) -> M (n x n, CRBA) [kg m^2, kg]");
+  mod.def("bias", [](const model& m) { return m.dispatch([](const auto& x, const auto&) { return bias_of(x); }, [](const auto& x) { return bias_of(x); }); },
+          py::arg("model"), "bias(model) -> f(q, qd) -> h = C(q, qd) qd + g(q) (n entries)");
+  mod.def("inverse_dynamics",
+          [](const model& m) { return m.dispatch([](const auto& x, const auto& c) { return nh_id_of(x, c); }, [](const auto& x) { return rne_of(x); }); },
+          py::arg("model"),
+          R"(inverse_dynamics(model) -> f(q, eta, eta_dot) -> tau
+
+The paper's nonholonomic inverse dynamics, project o rne o lift: q (n), eta and eta_dot (m,
+named by model.eta) -> tau (m actuator forces). A model without a constraint: eta = qd, and
+this is rne.)");
+  mod.def("inverse_dynamics_with_forces",
+          [](const model& m) { return m.dispatch([](const auto& x, const auto& c) { return nh_id_forces_of(x, c); },
+                                                  [&](const auto&) { return not_constrained(m, "inverse_dynamics_with_forces"); }); },
+          py::arg("model"), "inverse_dynamics_with_forces(model) -> f(q, eta, eta_dot) -> (tau, lambda): lambda the k constraint forces");
+  mod.def("forward_dynamics",
+          [](const model& m) { return m.dispatch([](const auto& x, const auto& c) { return nh_fd_of(x, c); }, [](const auto& x) { return holonomic_fd_of(x); }); },
+          py::arg("model"),
+          R"(forward_dynamics(model) -> f(q, eta_or_qd, tau) -> eta_dot or qdd
+
+Constrained: eta_dot = M_eta^-1 (S^T E tau - h_eta) (m entries). Holonomic: qdd (n entries),
+by CRBA + LDL^T or ABA (chosen as the C++ forward_dynamics does). Raises NumericalError for
+a singular mass matrix.)");
+}

@@ -1,0 +1,143 @@
+"""The Python module against the C++ library (through the nhdyn tool, whose JSON numbers
+read back bit for bit), against a closed form computed here in NumPy, and its batches,
+threads, dtypes and errors. Run by ctest (python_tests) with PYTHONPATH at the built module."""
+import json
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import nhdyn
+
+SOURCE = os.environ.get("NHDYN_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+TOOL = os.environ.get("NHDYN_TOOL")
+
+
+def tool(model, lines):
+    """Runs `nhdyn id|fd --model MODEL` on JSON lines; returns the parsed output lines."""
+    if not TOOL:
+        pytest.skip("NHDYN_TOOL not set (the tool was not built)")
+    out = subprocess.run([TOOL, *model], input="\n".join(json.dumps(l) for l in lines) + "\n",
+                         capture_output=True, text=True, check=True).stdout
+    return [json.loads(l) for l in out.splitlines()]
+
+
+def test_models_load_with_names_and_sizes():
+    assert "paper5" in nhdyn.presets() and "puma560_motors" in nhdyn.presets()
+    p = nhdyn.load("paper5")
+    assert (p.name, p.dof, p.m, p.k, p.constrained) == ("paper5", 5, 4, 1, True)
+    assert p.joints == ["joint1", "joint2", "joint3", "joint4", "joint5"]
+    assert len(p.eta) == 4
+    puma = nhdyn.load(os.path.join(SOURCE, "examples", "models", "puma560.json"))
+    assert (puma.dof, puma.k, puma.constrained) == (6, 0, False)
+    assert "paper5" in repr(p)
+
+
+def test_values_equal_the_cpp_library_to_the_last_bit():
+    rng = np.random.default_rng(1)
+    puma = nhdyn.load("puma560")
+    q, qd, qdd = rng.uniform(-2, 2, (3, 6))
+    (ref,) = tool(["id", "--model", "puma560"], [{"q": q.tolist(), "qd": qd.tolist(), "qdd": qdd.tolist()}])
+    assert np.array_equal(nhdyn.rne(puma)(q, qd, qdd), np.array(ref["tau"]))
+    (fd,) = tool(["fd", "--model", "puma560"], [{"q": q.tolist(), "qd": qd.tolist(), "tau": qdd.tolist()}])
+    assert np.array_equal(nhdyn.forward_dynamics(puma)(q, qd, qdd), np.array(fd["qdd"]))
+    p = nhdyn.load("paper5")
+    q, eta, eta_dot = rng.uniform(-1, 1, 5), rng.uniform(-1, 1, 4), rng.uniform(-1, 1, 4)
+    (ref,) = tool(["id", "--model", "paper5"], [{"q": q.tolist(), "eta": eta.tolist(), "eta_dot": eta_dot.tolist()}])
+    tau, lam = nhdyn.inverse_dynamics_with_forces(p)(q, eta, eta_dot)
+    assert np.array_equal(tau, np.array(ref["tau"])) and np.array_equal(lam, np.array(ref["lambda"]))
+    assert np.array_equal(nhdyn.inverse_dynamics(p)(q, eta, eta_dot), tau)
+
+
+def test_a_planar_two_link_arm_equals_its_closed_form_computed_in_numpy(tmp_path):
+    l1, l2, m1, m2, g = 0.7, 0.5, 3.0, 2.0, 9.81
+    link = lambda l, m: {"joint": "revolute", "alpha": 0, "a": l, "theta": 0, "d": 0, "mass": m,
+                         "com": [-l / 2, 0, 0], "inertia": [[0, 0, 0], [0, m * l * l / 12, 0], [0, 0, m * l * l / 12]]}
+    path = tmp_path / "arm.json"
+    path.write_text(json.dumps({"name": "arm", "gravity": [0, -g, 0], "links": [link(l1, m1), link(l2, m2)]}))
+    arm = nhdyn.load(str(path))
+    rng = np.random.default_rng(2)
+    for _ in range(10):
+        q, qd, qdd = rng.uniform(-2, 2, (3, 2))
+        c2, I1, I2, a1, a2 = np.cos(q[1]), m1 * l1**2 / 12, m2 * l2**2 / 12, l1 / 2, l2 / 2
+        M = np.array([[I1 + I2 + m1 * a1**2 + m2 * (l1**2 + a2**2 + 2 * l1 * a2 * c2), I2 + m2 * (a2**2 + l1 * a2 * c2)],
+                      [I2 + m2 * (a2**2 + l1 * a2 * c2), I2 + m2 * a2**2]])
+        h = m2 * l1 * a2 * np.sin(q[1])
+        C = np.array([-h * qd[1] * (2 * qd[0] + qd[1]), h * qd[0] ** 2])
+        G = g * np.array([(m1 * a1 + m2 * l1) * np.cos(q[0]) + m2 * a2 * np.cos(q[0] + q[1]), m2 * a2 * np.cos(q[0] + q[1])])
+        assert np.allclose(nhdyn.mass_matrix(arm)(q), M, rtol=1e-13, atol=1e-13)
+        assert np.allclose(nhdyn.rne(arm)(q, qd, qdd), M @ qdd + C + G, rtol=1e-12, atol=1e-12)
+        assert np.allclose(nhdyn.bias(arm)(q, qd), C + G, rtol=1e-12, atol=1e-12)
+        assert np.allclose(nhdyn.forward_dynamics(arm)(q, qd, M @ qdd + C + G), qdd, rtol=1e-10, atol=1e-10)
+
+
+def test_batches_equal_row_by_row_calls_on_any_number_of_threads():
+    p = nhdyn.load("paper5")
+    rng = np.random.default_rng(3)
+    N = 257
+    q, eta, eta_dot = rng.uniform(-1, 1, (N, 5)), rng.uniform(-1, 1, (N, 4)), rng.uniform(-1, 1, (N, 4))
+    f = nhdyn.inverse_dynamics(p)
+    batch = f(q, eta, eta_dot)
+    assert batch.shape == (N, 4)
+    rows = np.array([f(q[i], eta[i], eta_dot[i]) for i in range(N)])
+    assert np.array_equal(batch, rows)
+    assert np.array_equal(f(q, eta, eta_dot, threads=2), batch)
+    assert np.array_equal(f(q, eta, eta_dot, threads=7), batch)
+    M = nhdyn.mass_matrix(p)(q[:3])
+    assert M.shape == (3, 5, 5) and np.array_equal(M[1], nhdyn.mass_matrix(p)(q[1]))
+    tau, lam = nhdyn.inverse_dynamics_with_forces(p)(q, eta, eta_dot)
+    assert tau.shape == (N, 4) and lam.shape == (N, 1)
+
+
+def test_dtypes_are_converted_or_refused():
+    puma = nhdyn.load("puma560")
+    z = np.zeros(6)
+    ref = nhdyn.rne(puma)(z, z, z)
+    assert np.array_equal(nhdyn.rne(puma)(np.zeros(6, dtype=int), [0] * 6, np.zeros(6, dtype=np.float32)), ref)
+    with pytest.raises(TypeError, match="dtype"):
+        nhdyn.rne(puma)(np.zeros(6, dtype=complex), z, z)
+    with pytest.raises(TypeError, match="takes 3 arrays"):
+        nhdyn.rne(puma)(z, z)
+
+
+def test_errors_carry_the_library_messages():
+    puma = nhdyn.load("puma560")
+    z = np.zeros(6)
+    with pytest.raises(ValueError, match="'q' has 5 entries; the model needs 6"):
+        nhdyn.rne(puma)(np.zeros(5), z, z)
+    bad = z.copy()
+    bad[2] = np.nan
+    with pytest.raises(nhdyn.InputError, match=r"qd\[2\] is not finite"):
+        nhdyn.rne(puma)(z, bad, z)
+    with pytest.raises(nhdyn.InputError, match=r"row 1: .*qd\[2\] is not finite"):
+        nhdyn.rne(puma)(np.zeros((2, 6)), np.vstack([z, bad]), np.zeros((2, 6)))
+    with pytest.raises(nhdyn.ModelError, match="no such file"):
+        nhdyn.load("no/such/model.json")
+    with pytest.raises(nhdyn.ModelError, match="has no constraint"):
+        nhdyn.inverse_dynamics_with_forces(puma)
+    with pytest.raises(ValueError, match="rows"):
+        nhdyn.rne(puma)(np.zeros((2, 6)), np.zeros((3, 6)), np.zeros((2, 6)))
+    assert issubclass(nhdyn.NumericalError, ArithmeticError)
+
+
+def test_help_shows_signatures_and_units():
+    assert "f(q, qd, qdd) -> tau" in nhdyn.rne.__doc__ and "N m" in nhdyn.rne.__doc__
+    assert "rne(q[6], qd[6], qdd[6]) -> tau[6]" == nhdyn.rne(nhdyn.load("puma560")).signature
+    assert "eta_dot" in nhdyn.forward_dynamics.__doc__
+
+
+@pytest.mark.skipif(not hasattr(nhdyn, "load"), reason="")
+def test_a_robot_file_runs_the_papers_method():
+    path = os.path.join(SOURCE, "examples", "robots", "mobile_manipulator_wheels.json")
+    try:
+        r = nhdyn.load(path)
+    except nhdyn.ModelError as e:
+        if "without URDF support" in str(e):
+            pytest.skip(str(e))
+        raise
+    assert (r.dof, r.k, r.eta[0]) == (19, 3, "wheel_left_joint")
+    rng = np.random.default_rng(4)
+    q, eta, eta_dot = rng.uniform(-1, 1, r.dof), rng.uniform(-1, 1, r.m), rng.uniform(-1, 1, r.m)
+    tau = nhdyn.inverse_dynamics(r)(q, eta, eta_dot)
+    assert np.allclose(nhdyn.forward_dynamics(r)(q, eta, tau), eta_dot, rtol=1e-10, atol=1e-10)
