@@ -165,7 +165,7 @@ void register_fd(const std::string& model, const chain<double>& cd) {
   const state s = random_state(n, 23);
   const Eigen::VectorXd tau = s.qdd;  // any torques
   auto ab = nhdyn::aba(nhdyn::as_tree(cd));
-  auto cr = nhdyn::forward_dynamics(cd);
+  auto cr = nhdyn::forward_dynamics(cd, {}, {.method = nhdyn::fd_method::crba_ldlt});  // forced: the default picks by size
   const Eigen::VectorXd qdd = cr(s.q, s.qd, tau);
   agree(ab(s.q, s.qd, tau), qdd, 1e-9, "fd/" + model + ": aba vs CRBA + LDLT");
   const auto rows = kdl_rows(cd);

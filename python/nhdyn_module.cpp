@@ -8,10 +8,12 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <nhdyn/analysis/linearize.hpp>
 #include <nhdyn/io/json.hpp>
 #include <nhdyn/nhdyn.hpp>
 #include <optional>
@@ -189,6 +191,10 @@ class batch_function {
   /// error (by row) is rethrown, naming the row for a batch.
   void run(const std::vector<const double*>& in, const std::vector<double*>& out, py::ssize_t count, int threads) const {
     const bool batch = count > 1 || threads > 1;
+    if (!batch) {  // one state: no GIL hand-over, no bookkeeping (the call's overhead, docs/python.md)
+      f_(in, out);
+      return;
+    }
     std::vector<std::exception_ptr> errors(std::size_t(std::max(1, threads)));
     std::vector<py::ssize_t> error_row(errors.size(), -1);
     const auto rows = [&](int worker, py::ssize_t begin, py::ssize_t end) {
@@ -279,7 +285,7 @@ batch_function nh_id_of(const Model& mdl, const C& c) {
   const int n = mdl.dof(), k = c.m();
   const auto f = nhdyn::inverse_dynamics(mdl, c);
   return {"inverse_dynamics", {{"q", n}, {"eta", k}, {"eta_dot", k}}, {{"tau", k}}, [f, n, k](const auto& in, const auto& out) {
-            vmap(out[0], k) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], k)), VectorXd(cmap(in[2], k)));
+            vmap(out[0], k) = f(cmap(in[0], n), cmap(in[1], k), cmap(in[2], k));
           }};
 }
 template <class Model, class C>
@@ -288,7 +294,7 @@ batch_function nh_id_forces_of(const Model& mdl, const C& c) {
   const auto f = nhdyn::inverse_dynamics_with_forces(mdl, c);
   return {"inverse_dynamics_with_forces", {{"q", n}, {"eta", m}, {"eta_dot", m}}, {{"tau", m}, {"lambda", k}},
           [f, n, m, k](const auto& in, const auto& out) {
-            const auto r = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)), VectorXd(cmap(in[2], m)));
+            const auto r = f(cmap(in[0], n), cmap(in[1], m), cmap(in[2], m));
             vmap(out[0], m) = r.tau;
             vmap(out[1], k) = r.lambda;
           }};
@@ -298,7 +304,71 @@ batch_function nh_fd_of(const Model& mdl, const C& c) {
   const int n = mdl.dof(), m = c.m();
   const auto f = nhdyn::nh_forward_dynamics(mdl, c);
   return {"forward_dynamics", {{"q", n}, {"eta", m}, {"tau", m}}, {{"eta_dot", m}}, [f, n, m](const auto& in, const auto& out) {
-            vmap(out[0], m) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)), VectorXd(cmap(in[2], m)));
+            vmap(out[0], m) = f(cmap(in[0], n), cmap(in[1], m), cmap(in[2], m));
+          }};
+}
+
+/// A named place on a model: its body (1…n, 0 the base, as the kinematics count) and the
+/// named frame's placement on it.
+struct site {
+  int body = 0;
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+};
+site locate(const nhdyn::tree<double>& t, const std::string& name) {
+  const auto f = t.find_frame(name);
+  return {f.body + 1, f.R, f.p};
+}
+site locate(const nhdyn::chain<double>& c, const std::string& name) {
+  if (name == "base") return {};
+  for (int i = 1; i <= c.dof(); ++i)
+    if (name == "link" + std::to_string(i)) return {i};
+  throw nhdyn::input_error("model '" + c.name() + "' has no body '" + name + "' (bodies: base, link1 … link" +
+                           std::to_string(c.dof()) + ")");
+}
+nhdyn::kinematics<double> kinematics_of(const nhdyn::chain<double>& c) { return nhdyn::kinematics<double>(c); }
+nhdyn::tree_kinematics<double> kinematics_of(const nhdyn::tree<double>& t) { return nhdyn::tree_kinematics<double>(t); }
+
+template <class Model>
+batch_function frame_of(const Model& mdl, const std::string& name) {
+  const int n = mdl.dof();
+  const site s = locate(mdl, name);
+  const auto kin = kinematics_of(mdl);
+  return {"frame", {{"q", n}}, {{"T", 4, 4}}, [kin, s](const auto& in, const auto& out) {
+            const auto X = kin.frame(cmap(in[0], kin.dof()), s.body);
+            Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> T(out[0]);
+            T.setIdentity();
+            T.template topLeftCorner<3, 3>() = X.R * s.R;
+            T.template topRightCorner<3, 1>() = X.p + X.R * s.p;
+          }};
+}
+template <class Model>
+batch_function jacobian_of(const Model& mdl, const std::string& name, const Eigen::Vector3d& point) {
+  const int n = mdl.dof();
+  const site s = locate(mdl, name);
+  const Eigen::Vector3d p = s.R * point + s.p;
+  const auto kin = kinematics_of(mdl);
+  return {"jacobian", {{"q", n}}, {{"J", 6, n}}, [kin, s, p, n](const auto& in, const auto& out) {
+            Eigen::Map<rowmajor>(out[0], 6, n) = kin.jacobian(cmap(in[0], n), s.body, p);
+          }};
+}
+
+template <class Model>
+batch_function holonomic_linearize_of(const Model& mdl) {
+  const int n = mdl.dof();
+  return {"linearize", {{"q", n}, {"qd", n}, {"tau", n}}, {{"A", 2 * n, 2 * n}, {"B", 2 * n, n}}, [mdl, n](const auto& in, const auto& out) {
+            const auto ss = nhdyn::linearize_forward_dynamics(mdl, cmap(in[0], n), cmap(in[1], n), cmap(in[2], n));
+            Eigen::Map<rowmajor>(out[0], 2 * n, 2 * n) = ss.A;
+            Eigen::Map<rowmajor>(out[1], 2 * n, n) = ss.B;
+          }};
+}
+template <class Model, class C>
+batch_function nh_linearize_of(const Model& mdl, const C& c) {
+  const int n = mdl.dof(), m = c.m();
+  return {"linearize", {{"q", n}, {"eta", m}, {"tau", m}}, {{"A", n + m, n + m}, {"B", n + m, m}}, [mdl, c, n, m](const auto& in, const auto& out) {
+            const auto ss = nhdyn::linearize_forward_dynamics(mdl, c, cmap(in[0], n), cmap(in[1], m), cmap(in[2], m));
+            Eigen::Map<rowmajor>(out[0], n + m, n + m) = ss.A;
+            Eigen::Map<rowmajor>(out[1], n + m, m) = ss.B;
           }};
 }
 
@@ -372,6 +442,35 @@ this is rne.)");
           [](const model& m) { return m.dispatch([](const auto& x, const auto& c) { return nh_id_forces_of(x, c); },
                                                   [&](const auto&) { return not_constrained(m, "inverse_dynamics_with_forces"); }); },
           py::arg("model"), "inverse_dynamics_with_forces(model) -> f(q, eta, eta_dot) -> (tau, lambda): lambda the k constraint forces");
+  mod.def("linearize",
+          [](const model& m) { return m.dispatch([](const auto& x, const auto& c) { return nh_linearize_of(x, c); }, [](const auto& x) { return holonomic_linearize_of(x); }); },
+          py::arg("model"),
+          R"(linearize(model) -> f(q, eta_or_qd, tau) -> (A, B)
+
+The exact linearisation x_dot = A dx + B du of the forward dynamics (dual numbers, from the
+inverse dynamics by the implicit-function theorem). Constrained: x = (q, eta), u = tau,
+A (n+m) x (n+m), B (n+m) x m. Holonomic: x = (q, qd), A 2n x 2n, B 2n x n.)");
+  mod.def("frame",
+          [](const model& m, const std::string& name) {
+            return m.dispatch([&](const auto& x, const auto&) { return frame_of(x, name); }, [&](const auto& x) { return frame_of(x, name); });
+          },
+          py::arg("model"), py::arg("name"),
+          R"(frame(model, name) -> f(q) -> T (4 x 4)
+
+The pose of a body or frame in the base (world) frame: [[R, p], [0, 0, 0, 1]], p in m. Names:
+a URDF's links and merged frames; a DH model's base, link1 ... linkN.)");
+  mod.def("jacobian",
+          [](const model& m, const std::string& name, const std::array<double, 3>& point) {
+            const Eigen::Vector3d p(point[0], point[1], point[2]);
+            return m.dispatch([&](const auto& x, const auto&) { return jacobian_of(x, name, p); },
+                              [&](const auto& x) { return jacobian_of(x, name, p); });
+          },
+          py::arg("model"), py::arg("name"), py::arg("point") = std::array<double, 3>{0, 0, 0},
+          R"(jacobian(model, name, point=(0, 0, 0)) -> f(q) -> J (6 x n)
+
+The geometric Jacobian of a point fixed on a body or frame (point in that frame, m), in the
+base frame: rows 0-2 the point's velocity [m/s], rows 3-5 the angular velocity [rad/s] per
+unit qd.)");
   mod.def("forward_dynamics",
           [](const model& m) { return m.dispatch([](const auto& x, const auto& c) { return nh_fd_of(x, c); }, [](const auto& x) { return holonomic_fd_of(x); }); },
           py::arg("model"),

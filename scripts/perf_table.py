@@ -205,8 +205,10 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
     # ---------------------------------------------------------------- forward dynamics
     out.append("### Holonomic forward dynamics: ABA, CRBA + LDLᵀ and KDL's ChainFdSolver_RNE (issue 15)\n")
     out.append("`fd/<model>/{aba, crba_ldlt, kdl}`: the articulated-body algorithm (`nhdyn::aba`, on the chain "
-               "as a tree, run-time sized), the chain's `forward_dynamics` (CRBA mass matrix + LDLᵀ), and KDL's "
-               "`ChainFdSolver_RNE` on the same chain and state.\n")
+               "as a tree, run-time sized), the chain's `forward_dynamics` forced to CRBA + LDLᵀ "
+               "(`fd_method::crba_ldlt`: CRBA mass matrix, LDLᵀ), and KDL's `ChainFdSolver_RNE` on the same chain "
+               "and state. The default `forward_dynamics` (`fd_method::automatic`) is the CRBA + LDLᵀ column below "
+               "40 joints and the ABA column from 40 on.\n")
     out.append("| model | n | ABA | CRBA + LDLᵀ | KDL | ABA / KDL | CRBA / KDL | faster of ours |")
     out.append("|---|---:|---:|---:|---:|---:|---:|---|")
     worst_aba = 0.0

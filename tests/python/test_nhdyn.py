@@ -70,6 +70,13 @@ def test_a_planar_two_link_arm_equals_its_closed_form_computed_in_numpy(tmp_path
         assert np.allclose(nhdyn.rne(arm)(q, qd, qdd), M @ qdd + C + G, rtol=1e-12, atol=1e-12)
         assert np.allclose(nhdyn.bias(arm)(q, qd), C + G, rtol=1e-12, atol=1e-12)
         assert np.allclose(nhdyn.forward_dynamics(arm)(q, qd, M @ qdd + C + G), qdd, rtol=1e-10, atol=1e-10)
+        # kinematics: the tip's pose and Jacobian
+        s1, c1, s12, c12 = np.sin(q[0]), np.cos(q[0]), np.sin(q[0] + q[1]), np.cos(q[0] + q[1])
+        T = nhdyn.frame(arm, "link2")(q)
+        assert np.allclose(T[:3, 3], [l1 * c1 + l2 * c12, l1 * s1 + l2 * s12, 0], atol=1e-15)
+        assert np.allclose(T[:3, :3], [[c12, -s12, 0], [s12, c12, 0], [0, 0, 1]], atol=1e-15)
+        J = nhdyn.jacobian(arm, "link2")(q)
+        assert np.allclose(J, [[-l1 * s1 - l2 * s12, -l2 * s12], [l1 * c1 + l2 * c12, l2 * c12], [0, 0], [0, 0], [0, 0], [1, 1]], atol=1e-15)
 
 
 def test_batches_equal_row_by_row_calls_on_any_number_of_threads():
@@ -141,3 +148,36 @@ def test_a_robot_file_runs_the_papers_method():
     q, eta, eta_dot = rng.uniform(-1, 1, r.dof), rng.uniform(-1, 1, r.m), rng.uniform(-1, 1, r.m)
     tau = nhdyn.inverse_dynamics(r)(q, eta, eta_dot)
     assert np.allclose(nhdyn.forward_dynamics(r)(q, eta, tau), eta_dot, rtol=1e-10, atol=1e-10)
+    # the tool point's Jacobian against central differences of its position, in NumPy
+    pose, J = nhdyn.frame(r, "tool_frame"), nhdyn.jacobian(r, "tool_frame", (0.0, 0.0, 0.05))
+    point = lambda x: (pose(x) @ np.array([0, 0, 0.05, 1]))[:3]
+    h, Jq = 1e-6, J(q)
+    num = np.column_stack([(point(q + h * e) - point(q - h * e)) / (2 * h) for e in np.eye(r.dof)])
+    assert np.allclose(Jq[:3], num, atol=1e-8)
+    with pytest.raises(nhdyn.InputError, match="no body named 'nowhere'"):
+        nhdyn.frame(r, "nowhere")
+
+
+def test_linearize_equals_central_differences_of_forward_dynamics():
+    rng = np.random.default_rng(5)
+    puma = nhdyn.load("puma560")
+    q, qd, tau = rng.uniform(-1, 1, (3, 6))
+    A, B = nhdyn.linearize(puma)(q, qd, tau)
+    fd, h, n = nhdyn.forward_dynamics(puma), 1e-6, 6
+    x = np.concatenate([q, qd])
+    f = lambda x, u: np.concatenate([x[n:], fd(x[:n], x[n:], u)])
+    An = np.column_stack([(f(x + h * e, tau) - f(x - h * e, tau)) / (2 * h) for e in np.eye(2 * n)])
+    Bn = np.column_stack([(f(x, tau + h * e) - f(x, tau - h * e)) / (2 * h) for e in np.eye(n)])
+    assert np.allclose(A, An, atol=1e-6 * (1 + abs(An).max())) and np.allclose(B, Bn, atol=1e-6 * (1 + abs(Bn).max()))
+    # constrained: the eta_dot rows against differences of the constrained forward dynamics
+    p = nhdyn.load("paper5")
+    q, eta, tau = rng.uniform(-1, 1, 5), rng.uniform(-1, 1, 4), rng.uniform(-1, 1, 4)
+    A, B = nhdyn.linearize(p)(q, eta, tau)
+    assert A.shape == (9, 9) and B.shape == (9, 4)
+    fd = nhdyn.forward_dynamics(p)
+    x = np.concatenate([q, eta])
+    g = lambda x, u: fd(x[:5], x[5:], u)
+    An = np.column_stack([(g(x + h * e, tau) - g(x - h * e, tau)) / (2 * h) for e in np.eye(9)])
+    Bn = np.column_stack([(g(x, tau + h * e) - g(x, tau - h * e)) / (2 * h) for e in np.eye(4)])
+    assert np.allclose(A[5:], An, atol=1e-6 * (1 + abs(An).max())) and np.allclose(B[5:], Bn, atol=1e-6 * (1 + abs(Bn).max()))
+    assert np.array_equal(B[:5], np.zeros((5, 4)))
