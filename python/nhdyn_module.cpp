@@ -285,7 +285,11 @@ batch_function nh_id_of(const Model& mdl, const C& c) {
   const int n = mdl.dof(), k = c.m();
   const auto f = nhdyn::inverse_dynamics(mdl, c);
   return {"inverse_dynamics", {{"q", n}, {"eta", k}, {"eta_dot", k}}, {{"tau", k}}, [f, n, k](const auto& in, const auto& out) {
-            vmap(out[0], k) = f(cmap(in[0], n), cmap(in[1], k), cmap(in[2], k));
+            // the state in per-thread vectors of the library's own type: its run-time-sized
+            // fast path (stack scratch, no heap) takes them; a Map argument took the generic one
+            thread_local VectorXd q, eta, eta_dot;
+            q = cmap(in[0], n), eta = cmap(in[1], k), eta_dot = cmap(in[2], k);
+            vmap(out[0], k) = f(q, eta, eta_dot);
           }};
 }
 template <class Model, class C>
