@@ -376,6 +376,24 @@ batch_function nh_linearize_of(const Model& mdl, const C& c) {
           }};
 }
 
+template <class Model, class C>
+batch_function nh_state_derivative_of(const Model& mdl, const C& c) {
+  const int n = mdl.dof(), m = c.m();
+  const auto f = nhdyn::nh_forward_dynamics(mdl, c);
+  return {"state_derivative", {{"q", n}, {"eta", m}, {"tau", m}}, {{"xdot", n + m}}, [f, n, m](const auto& in, const auto& out) {
+            vmap(out[0], n + m) = f.state_derivative(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)), VectorXd(cmap(in[2], m)));
+          }};
+}
+template <class Model>
+batch_function holonomic_state_derivative_of(const Model& mdl) {
+  const int n = mdl.dof();
+  const auto f = nhdyn::forward_dynamics(mdl);
+  return {"state_derivative", {{"q", n}, {"qd", n}, {"tau", n}}, {{"xdot", 2 * n}}, [f, n](const auto& in, const auto& out) {
+            vmap(out[0], n) = cmap(in[1], n);
+            vmap(out[0] + n, n) = f(cmap(in[0], n), cmap(in[1], n), cmap(in[2], n));
+          }};
+}
+
 batch_function not_constrained(const model& m, const char* what) {
   throw nhdyn::model_error("model '" + m.name + "' has no constraint: " + what + " needs one (use rne)");
 }
@@ -454,6 +472,16 @@ this is rne.)");
 The exact linearisation x_dot = A dx + B du of the forward dynamics (dual numbers, from the
 inverse dynamics by the implicit-function theorem). Constrained: x = (q, eta), u = tau,
 A (n+m) x (n+m), B (n+m) x m. Holonomic: x = (q, qd), A 2n x 2n, B 2n x n.)");
+  mod.def("state_derivative",
+          [](const model& m) {
+            return m.dispatch([](const auto& x, const auto& c) { return nh_state_derivative_of(x, c); },
+                              [](const auto& x) { return holonomic_state_derivative_of(x); });
+          },
+          py::arg("model"),
+          R"(state_derivative(model) -> f(q, eta_or_qd, tau) -> xdot
+
+For integrators: constrained x = (q, eta), xdot = (S(q) eta, eta_dot) (n + m entries);
+holonomic x = (q, qd), xdot = (qd, qdd) (2n entries).)");
   mod.def("frame",
           [](const model& m, const std::string& name) {
             return m.dispatch([&](const auto& x, const auto&) { return frame_of(x, name); }, [&](const auto& x) { return frame_of(x, name); });

@@ -8,7 +8,7 @@ pkgs=(
   libboost-dev liborocos-kdl-dev nlohmann-json3-dev libcli11-dev
   liburdfdom-dev libtinyxml2-dev
   gnuplot-nox python3 python3-matplotlib
-  pybind11-dev python3-dev python3-numpy python3-pytest
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy
 )
 missing=()
 for p in "${pkgs[@]}"; do
