@@ -312,34 +312,16 @@ batch_function nh_fd_of(const Model& mdl, const C& c) {
           }};
 }
 
-/// A named place on a model: its body (1…n, 0 the base, as the kinematics count) and the
-/// named frame's placement on it.
-struct site {
-  int body = 0;
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
-};
-site locate(const nhdyn::tree<double>& t, const std::string& name) {
-  const auto f = t.find_frame(name);
-  return {f.body + 1, f.R, f.p};
-}
-site locate(const nhdyn::chain<double>& c, const std::string& name) {
-  if (name == "base") return {};
-  for (int i = 1; i <= c.dof(); ++i)
-    if (name == "link" + std::to_string(i)) return {i};
-  throw nhdyn::input_error("model '" + c.name() + "' has no body '" + name + "' (bodies: base, link1 … link" +
-                           std::to_string(c.dof()) + ")");
-}
 nhdyn::kinematics<double> kinematics_of(const nhdyn::chain<double>& c) { return nhdyn::kinematics<double>(c); }
 nhdyn::tree_kinematics<double> kinematics_of(const nhdyn::tree<double>& t) { return nhdyn::tree_kinematics<double>(t); }
 
 template <class Model>
 batch_function frame_of(const Model& mdl, const std::string& name) {
   const int n = mdl.dof();
-  const site s = locate(mdl, name);
+  const auto s = nhdyn::find_frame(mdl, name);  // s.body: 0-based, −1 the base
   const auto kin = kinematics_of(mdl);
   return {"frame", {{"q", n}}, {{"T", 4, 4}}, [kin, s](const auto& in, const auto& out) {
-            const auto X = kin.frame(cmap(in[0], kin.dof()), s.body);
+            const auto X = kin.frame(cmap(in[0], kin.dof()), s.body + 1);
             Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> T(out[0]);
             T.setIdentity();
             T.template topLeftCorner<3, 3>() = X.R * s.R;
@@ -349,11 +331,12 @@ batch_function frame_of(const Model& mdl, const std::string& name) {
 template <class Model>
 batch_function jacobian_of(const Model& mdl, const std::string& name, const Eigen::Vector3d& point) {
   const int n = mdl.dof();
-  const site s = locate(mdl, name);
+  const auto s = nhdyn::find_frame(mdl, name);
   const Eigen::Vector3d p = s.R * point + s.p;
   const auto kin = kinematics_of(mdl);
-  return {"jacobian", {{"q", n}}, {{"J", 6, n}}, [kin, s, p, n](const auto& in, const auto& out) {
-            Eigen::Map<rowmajor>(out[0], 6, n) = kin.jacobian(cmap(in[0], n), s.body, p);
+  const int body = s.body + 1;
+  return {"jacobian", {{"q", n}}, {{"J", 6, n}}, [kin, body, p, n](const auto& in, const auto& out) {
+            Eigen::Map<rowmajor>(out[0], 6, n) = kin.jacobian(cmap(in[0], n), body, p);
           }};
 }
 

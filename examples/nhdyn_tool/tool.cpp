@@ -187,24 +187,7 @@ Eigen::VectorXd line::vector(std::string_view key, int n) const {
   return v;
 }
 
-located_body locate_body(const nhdyn::tree<double>& t, const std::string& name) {
-  const auto f = t.find_frame(name);  // input_error naming the model for an unknown name
-  return {f.body + 1, f.R, f.p};
-}
-located_body locate_body(const nhdyn::chain<double>& c, const std::string& name) {
-  if (name == "base") return {};
-  const std::string pre = "link";
-  if (name.size() > pre.size() && name.compare(0, pre.size(), pre) == 0 &&
-      name.find_first_not_of("0123456789", pre.size()) == std::string::npos && name.size() <= pre.size() + 6) {
-    const int i = std::stoi(name.substr(pre.size()));
-    if (i >= 1 && i <= c.dof()) return {i};
-  }
-  throw nhdyn::input_error("model '" + c.name() + "' has no body '" + name + "' (bodies: base, link1 … link" +
-                           std::to_string(c.dof()) + ")");
-}
-
-std::vector<nhdyn::wrench<double>> line_wrenches(const line& l,
-                                                 const std::function<located_body(const std::string&)>& locate) {
+std::vector<nhdyn::wrench<double>> line_wrenches(const line& l, const wrench_maker& make) {
   std::vector<nhdyn::wrench<double>> out;
   if (!l.has("f_ext")) return out;
   const json& a = l.raw()["f_ext"];
@@ -217,7 +200,6 @@ std::vector<nhdyn::wrench<double>> line_wrenches(const line& l,
       if (it.key() != "body" && it.key() != "frame" && it.key() != "point" && it.key() != "force" && it.key() != "moment")
         throw nhdyn::input_error(w + ": unknown key '" + it.key() + "' (known: body, frame, point, force, moment)");
     if (!e.contains("body") || !e["body"].is_string()) throw nhdyn::input_error(w + ": 'body' (a body name) is missing");
-    const located_body b = locate(e["body"].get<std::string>());
     nhdyn::wrench_frame frame = nhdyn::wrench_frame::world;
     if (e.contains("frame")) {
       if (e["frame"] == "body") frame = nhdyn::wrench_frame::body;
@@ -232,13 +214,7 @@ std::vector<nhdyn::wrench<double>> line_wrenches(const line& l,
       for (int r = 0; r < 3; ++r) v(r) = finite_number(x[std::size_t(r)], what + "[" + std::to_string(r) + "]");
       return v;
     };
-    nhdyn::wrench<double> x;
-    x.body = b.body;
-    x.frame = frame;
-    x.point = b.R * v3("point") + b.p;
-    x.force = frame == nhdyn::wrench_frame::body ? Eigen::Vector3d(b.R * v3("force")) : v3("force");
-    x.moment = frame == nhdyn::wrench_frame::body ? Eigen::Vector3d(b.R * v3("moment")) : v3("moment");
-    out.push_back(x);
+    out.push_back(make(e["body"].get<std::string>(), frame, v3("point"), v3("force"), v3("moment")));
   }
   return out;
 }

@@ -122,26 +122,21 @@ class line {
   json j_;
 };
 
-/// A body named on a line: its index as the kinematics count it (1…n; 0: the base) and the
-/// placement (R, p) on that body of the named frame (a merged fixed link's, or the identity).
-struct located_body {
-  int body = 0;
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
-};
-/// A tree's body or merged frame by name; a DH chain's "base", "link1" … "link<n>".
-located_body locate_body(const nhdyn::tree<double>& t, const std::string& name);
-located_body locate_body(const nhdyn::chain<double>& c, const std::string& name);
-
 /// The line's optional "f_ext": a list of {"body": NAME, "frame": "world" | "body" (default
 /// world), "point": [x, y, z], "force": [..], "moment": [..]} (each vector optional, zero by
 /// default; point in the named frame, force and moment in the frame "frame" says); empty if
 /// the key is absent. Errors name the entry and the field.
-std::vector<nhdyn::wrench<double>> line_wrenches(const line& l,
-                                                 const std::function<located_body(const std::string&)>& locate);
+using wrench_maker = std::function<nhdyn::wrench<double>(const std::string& body, nhdyn::wrench_frame frame,
+                                                          const Eigen::Vector3d& point, const Eigen::Vector3d& force,
+                                                          const Eigen::Vector3d& moment)>;
+std::vector<nhdyn::wrench<double>> line_wrenches(const line& l, const wrench_maker& make);
+/// line_wrenches on a model: bodies and frames named as nhdyn::wrench_on takes them.
 template <class Model>
 std::vector<nhdyn::wrench<double>> wrenches_of(const line& l, const Model& model) {
-  return line_wrenches(l, [&](const std::string& s) { return locate_body(model, s); });
+  return line_wrenches(l, [&](const std::string& body, nhdyn::wrench_frame frame, const Eigen::Vector3d& point,
+                              const Eigen::Vector3d& force, const Eigen::Vector3d& moment) {
+    return nhdyn::wrench_on(model, body, frame, point, force, moment);
+  });
 }
 /// `keys`, and "f_ext" if the line has it (the optional key of id and fd lines).
 inline std::vector<std::string> with_f_ext(const line& l, std::vector<std::string> keys) {

@@ -91,7 +91,20 @@ class nh_forward_dynamics_fn : public stage_tag {
     return solve(q, eta, tau, &Qx);
   }
 
+  /// The state derivative for integrators: x = (q, η) ↦ ẋ = (q̇, η̇) = (S η, η̇), n + m entries.
+  template <class Q, class E, class TAU>
+  auto state_derivative(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
+                        const Eigen::MatrixBase<TAU>& tau) const {
+    const auto eta_dot = (*this)(q, eta, tau);
+    using T = typename decltype(eta_dot)::Scalar;
+    constexpr int NX = N == dynamic || M == dynamic ? dynamic : N + M;
+    vecN<T, NX> dx(c_.dof() + c_.m());
+    dx << apply_S(c_, q, eta).template cast<T>(), eta_dot;
+    return dx;
+  }
+
  private:
+  /// η̇ for τ and, when Qx is not null, the applied forces' generalized force Q_ext.
   template <class Q, class E, class TAU, class QX>
   auto solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
              const QX* Qx) const {
@@ -123,21 +136,6 @@ class nh_forward_dynamics_fn : public stage_tag {
     return eta_dot;
   }
 
- public:
-
-  /// The state derivative for integrators: x = (q, η) ↦ ẋ = (q̇, η̇) = (S η, η̇), n + m entries.
-  template <class Q, class E, class TAU>
-  auto state_derivative(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
-                        const Eigen::MatrixBase<TAU>& tau) const {
-    const auto eta_dot = (*this)(q, eta, tau);
-    using T = typename decltype(eta_dot)::Scalar;
-    constexpr int NX = N == dynamic || M == dynamic ? dynamic : N + M;
-    vecN<T, NX> dx(c_.dof() + c_.m());
-    dx << apply_S(c_, q, eta).template cast<T>(), eta_dot;
-    return dx;
-  }
-
- private:
   C c_;
   rne_type rne_;
   rne_type inertia_rne_;

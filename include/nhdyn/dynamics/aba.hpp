@@ -126,10 +126,7 @@ class aba_fn : public stage_tag {
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                   const F& fx) const {
     detail::check_size(tau, t_.dof(), "tau");
-    const auto Qx = fx.generalized_force(q);
-    using R = promote_t<typename TAU::Scalar, typename decltype(Qx)::Scalar>;
-    const vecN<R, dynamic> t = tau.template cast<R>() + Qx.template cast<R>();
-    return (*this)(q, qd, t);
+    return (*this)(q, qd, detail::plus_applied(tau, fx, q));
   }
 
  private:

@@ -72,14 +72,16 @@ class forward_dynamics_fn : public stage_tag {
     detail::check_finite(tau, "tau");
     if (fd_.method == fd_method::aba || (fd_.method == fd_method::automatic && n_ >= fd_.aba_from)) return by_aba<T>(q, qd, tau);
     const auto h = rne_(q, qd, vecN<X, N>::Zero(q.size()));
-    std::optional<ldlt<T, N>> f;
-    if constexpr (std::is_same_v<T, promote_t<S, X>>)
-      f.emplace(ldlt_factor<T, N>(M_(q), "the mass matrix M(q)"));
-    else
-      f.emplace(ldlt_factor<T, N>(Eigen::Matrix<T, N, N>(M_(q).template cast<T>()), "the mass matrix M(q)"));
+    const auto M = [&] {  // M in T (a dual τ makes T a dual while M(q) is not)
+      if constexpr (std::is_same_v<T, promote_t<S, X>>)
+        return M_(q);
+      else
+        return Eigen::Matrix<T, N, N>(M_(q).template cast<T>());
+    }();
+    const auto f = ldlt_factor<T, N>(M, "the mass matrix M(q)");
     const double switch_at = fd_.aba_scaled_condition > 0 ? fd_.aba_scaled_condition : std::sqrt(default_max_pivot_ratio<T>());
-    if (fd_.method == fd_method::automatic && 1.0 / f->min_scaled_pivot > switch_at) return by_aba<T>(q, qd, tau);
-    vecN<T, N> qdd = f->solve(tau.template cast<T>() - h.template cast<T>());
+    if (fd_.method == fd_method::automatic && 1.0 / f.min_scaled_pivot > switch_at) return by_aba<T>(q, qd, tau);
+    vecN<T, N> qdd = f.solve(tau.template cast<T>() - h.template cast<T>());
     detail::check_overflow(qdd, "forward_dynamics");
     return qdd;
   }
@@ -89,20 +91,16 @@ class forward_dynamics_fn : public stage_tag {
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                   const F& fx) const {
     detail::check_size(tau, n_, "tau");
-    const auto Qx = fx.generalized_force(q);
-    using R = promote_t<typename TAU::Scalar, typename decltype(Qx)::Scalar>;
-    const vecN<R, dynamic> t = tau.template cast<R>() + Qx.template cast<R>();
-    return (*this)(q, qd, t);
+    return (*this)(q, qd, detail::plus_applied(tau, fx, q));
   }
 
  private:
   template <class T, class Q, class QD, class TAU>
   vecN<T, N> by_aba(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau) const {
     using X = typename QD::Scalar;
-    const vecN<X, dynamic> v = opt_.velocity ? vecN<X, dynamic>(qd) : vecN<X, dynamic>::Zero(qd.size());
-    detail::check_size(qd, n_, "qd");
-    if (opt_.velocity) detail::check_finite(qd, "qd");
-    return (*aba_)(q, v, tau).template cast<T>();
+    if (opt_.velocity) return vecN<T, N>((*aba_)(q, qd, tau).template cast<T>());  // aba checks q̇
+    detail::check_size(qd, n_, "qd");  // without velocity terms q̇ is not read, as in rne
+    return vecN<T, N>((*aba_)(q, vecN<X, dynamic>::Zero(n_), tau).template cast<T>());
   }
 
   mass_matrix_type M_;

@@ -72,13 +72,8 @@ template <class T>
 T coulomb_term(const T& x, double pos, double neg, const coulomb_law& law) {
   if constexpr (interval_like<T>) {
     if (law.velocity_scale == 0) {  // the hull of the law's values on [lo, hi]
-      const double lo = x.lower(), hi = x.upper();
-      double a = hi > 0 ? pos : 0, b = a;  // running [min, max] of what the law takes
-      const auto take = [&](double v) { a = std::min(a, v), b = std::max(b, v); };
-      if (lo < 0) take(neg);
-      if (lo <= 0 && hi >= 0) take(0);
-      if (hi > 0) take(pos);
-      return T(a, b);
+      const double lo = x.lower(), hi = x.upper();  // the law takes neg below 0, 0 at 0, pos above
+      return T(lo < 0 ? neg : lo > 0 ? pos : 0.0, hi > 0 ? pos : hi < 0 ? neg : 0.0);
     }
     // smooth: monotone in x, so its values at the ends enclose it (each end evaluated in T,
     // whose arithmetic rounds outwards)

@@ -196,11 +196,7 @@ class tree_rne_fn : public stage_tag {
   template <class Q, class QD, class QDD, applied_forces F>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
                   const F& fx) const {
-    const auto v = (*this)(q, qd, qdd);
-    const auto Qx = fx.generalized_force(q);
-    using R = promote_t<typename decltype(v)::Scalar, typename decltype(Qx)::Scalar>;
-    vecN<R, dynamic> out = v.template cast<R>() - Qx.template cast<R>();
-    return out;
+    return detail::minus_applied<dynamic>((*this)(q, qd, qdd), fx, q);
   }
 
   /// Pipeline form: ξ = (q, q̇, q̈) → (q, v).

@@ -125,12 +125,13 @@ auto external_wrenches(const tree<S>& t, std::vector<wrench<W>> w) {
   return external_wrenches_fn<tree_kinematics<S>, W>(tree_kinematics<S>(t), std::move(w));
 }
 
-/// A wrench on the body or merged (fixed-joint) frame called `name` of a tree: `point` and, for
+/// A wrench on the body called `name` of a chain or a tree (find_frame: a tree's bodies and
+/// merged fixed-joint frames, a chain's "link1" … "link<n>"): `point` and, for
 /// wrench_frame::body, force and moment are given in that named frame, and moved to its body.
-template <class S, class W = double>
-wrench<W> wrench_on(const tree<S>& t, const std::string& name, wrench_frame frame, const vec3<W>& point,
+template <class Model, class W = double>
+wrench<W> wrench_on(const Model& model, const std::string& name, wrench_frame frame, const vec3<W>& point,
                     const vec3<W>& force, const vec3<W>& moment = vec3<W>::Zero()) {
-  const auto f = t.find_frame(name);  // throws input_error naming the model for an unknown name
+  const auto f = find_frame(model, name);  // throws input_error naming the model for an unknown name
   wrench<W> w;
   w.body = f.body + 1;
   w.frame = frame;

@@ -52,4 +52,23 @@ struct constrained_forces {
 template <class F>
 concept applied_forces = requires { typename std::remove_cvref_t<F>::applied_forces_tag; };
 
+namespace detail {
+/// v − Q_ext(q), N entries in the common scalar: what rne returns with applied forces.
+template <int N, class V, class F, class Q>
+auto minus_applied(const V& v, const F& fx, const Q& q) {
+  const auto Qx = fx.generalized_force(q);
+  using R = promote_t<typename V::Scalar, typename decltype(Qx)::Scalar>;
+  vecN<R, N> out = v.template cast<R>() - Qx.template cast<R>();
+  return out;
+}
+/// τ + Q_ext(q) in the common scalar: what the forward dynamics solve for with applied forces.
+template <class Tau, class F, class Q>
+auto plus_applied(const Tau& tau, const F& fx, const Q& q) {
+  const auto Qx = fx.generalized_force(q);
+  using R = promote_t<typename Tau::Scalar, typename decltype(Qx)::Scalar>;
+  vecN<R, dynamic> out = tau.template cast<R>() + Qx.template cast<R>();
+  return out;
+}
+}  // namespace detail
+
 }  // namespace nhdyn

@@ -205,9 +205,7 @@ inline tree<double> with_drives(const tree<double>& t, const json& d, const plac
     auto& b = bodies[std::size_t(i)];
     joint_friction f = b.friction_law();
     read_drive(it.value(), at, b.armature, f);
-    b.damping = f.viscous;
-    b.friction = f.coulomb_pos;
-    b.friction_negative = f.coulomb_neg == -f.coulomb_pos ? std::nullopt : std::optional<double>(f.coulomb_neg);
+    b.set_friction_law(f);
   }
   try {
     return tree<double>(std::move(bodies), t.gravity(), t.name(), t.validation_policy(), t.root_name(), t.frames());

@@ -74,6 +74,12 @@ struct body {
 
   /// The friction law the friction stages use (dynamics/friction.hpp).
   joint_friction friction_law() const { return {damping, friction, friction_negative.value_or(-friction)}; }
+  /// Sets damping, friction and friction_negative to the law f.
+  void set_friction_law(const joint_friction& f) {
+    damping = f.viscous;
+    friction = f.coulomb_pos;
+    friction_negative = f.coulomb_neg == -f.coulomb_pos ? std::nullopt : std::optional<double>(f.coulomb_neg);
+  }
 
   template <class U>
   body<U> cast() const {
@@ -314,13 +320,28 @@ tree<S> as_tree(const chain<S, N>& c) {
     b.inertia = L.inertia;
     b.continuous = L.joint == joint_type::revolute;
     b.armature = L.armature;
-    b.damping = L.friction.viscous;
-    b.friction = L.friction.coulomb_pos;
-    if (L.friction.coulomb_neg != -L.friction.coulomb_pos) b.friction_negative = L.friction.coulomb_neg;
+    b.set_friction_law(L.friction);
     out.push_back(std::move(b));
   }
   validation v = c.validation_policy();
   return tree<S>(std::move(out), c.gravity(), c.name(), v, "base");
+}
+
+/// A chain's body by the name as_tree gives it ("base", "link1" … "link<n>"), as
+/// tree::find_frame does for a tree: its 0-based body (−1: the base) and an identity placement.
+/// Throws input_error for any other name.
+template <class S, int N>
+frame<S> find_frame(const chain<S, N>& c, const std::string& name) {
+  if (name == "base") return frame<S>{name, -1};
+  for (int i = 1; i <= c.dof(); ++i)
+    if (name == "link" + std::to_string(i)) return frame<S>{name, i - 1};
+  throw input_error("model '" + c.name() + "' has no body '" + name + "' (bodies: base, link1 … link" +
+                    std::to_string(c.dof()) + ")");
+}
+/// tree::find_frame as a free function, so that generic code names chains' and trees' bodies alike.
+template <class S>
+frame<S> find_frame(const tree<S>& t, const std::string& name) {
+  return t.find_frame(name);
 }
 
 }  // namespace nhdyn
