@@ -8,8 +8,8 @@
 ///   nh_inertia/<model>/{crba, rne_columns}      M_η = SᵀMS two ways
 ///   rne/<tree>/{nhdyn, reference, kdl}          rne on kinematic trees (the kernel, the plain
 ///   crba/<tree>/{nhdyn, reference}               spatial-algebra reference, KDL's tree solver);
-///   fd/<model>/{aba, crba_ldlt, kdl}            holonomic forward dynamics: the articulated-
-///                                               body algorithm, CRBA + LDLᵀ, KDL's ChainFdSolver_RNE
+///   fd/<model>/{aba, aba_reference, crba_ldlt, kdl}  holonomic forward dynamics: the articulated-
+///                                               body algorithm (kernel, reference), CRBA + LDLᵀ, KDL
 ///                                               mass matrix by the kernel and the reference
 ///   nh_id/<robot>/{rne, lagrange}               a robot file's nonholonomic inverse dynamics
 ///   nh_pair/<robot>/run_time                     (robot: mobile_manipulator_{ddrive, wheels,
@@ -178,6 +178,13 @@ void register_fd(const std::string& model, const chain<double>& cd) {
   add("fd/" + model + "/aba", [ab, s, tau]() mutable {
     opaque(s.q), opaque(s.qd), opaque(tau);
     auto r = ab(s.q, s.qd, tau);
+    benchmark::DoNotOptimize(r);
+  });
+  const auto tr = nhdyn::as_tree(cd);
+  agree(nhdyn::reference::aba<double>(tr, s.q, s.qd, tau), qdd, 1e-9, "fd/" + model + ": reference aba vs CRBA + LDLT");
+  add("fd/" + model + "/aba_reference", [tr, s, tau]() mutable {
+    opaque(s.q), opaque(s.qd), opaque(tau);
+    auto r = nhdyn::reference::aba<double>(tr, s.q, s.qd, tau);
     benchmark::DoNotOptimize(r);
   });
   add("fd/" + model + "/crba_ldlt", [cr, s, tau]() mutable {

@@ -6,9 +6,9 @@
 ///   LDLᵀ (detail/ldlt.hpp: refuses a matrix singular by its scaled criterion);
 /// - `fd_method::aba`: Featherstone's articulated-body algorithm (dynamics/aba.hpp), O(n),
 ///   never forming M;
-/// - `fd_method::automatic` (default): ABA from `aba_from` joints on (40: on revolute chains
-///   CRBA + LDLᵀ is faster up to 24 joints, ABA from 48, docs/performance.md), CRBA + LDLᵀ
-///   below — unless M's diagonally scaled pivots show it ill-conditioned (scaled ratio past
+/// - `fd_method::automatic` (default): ABA from `aba_from` joints on (9: on the benchmark's
+///   chains CRBA + LDLᵀ is 2–16 % faster at 5 and 6 joints, ABA 15 % faster at 12 and 1.9× at
+///   24, docs/performance.md), CRBA + LDLᵀ below — unless M's diagonally scaled pivots show it ill-conditioned (scaled ratio past
 ///   √(1/ε) of the scalar: 6.7e7 in double, 4.1e3 in float, where LDLᵀ keeps fewer than half
 ///   the digits): then ABA answers, which is more accurate there (docs/accuracy.md, mass
 ///   spans). Where LDLᵀ refuses M (not positive definite, or a scaled ratio past 1/ε: no digit
@@ -31,7 +31,7 @@ enum class fd_method { automatic, crba_ldlt, aba };
 /// How forward_dynamics chooses (see the file comment).
 struct fd_options {
   fd_method method = fd_method::automatic;
-  int aba_from = 40;                 ///< automatic: ABA from this many joints on
+  int aba_from = 9;                  ///< automatic: ABA from this many joints on
   double aba_scaled_condition = 0;   ///< automatic: ABA past this scaled pivot ratio of M (0: √(1/ε) of T)
 };
 
