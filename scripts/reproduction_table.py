@@ -47,7 +47,8 @@ def main():
     out_dir = sys.argv[1]
     doc = sys.argv[2] if len(sys.argv) > 2 else os.path.join(os.path.dirname(__file__), "..", "docs", "reproduction.md")
     with open(os.path.join(out_dir, "summary.json")) as f:
-        runs = json.load(f)
+        data = json.load(f)
+    runs = data["runs"] if isinstance(data, dict) else data  # {"runs", "aggregate"}; a list before
 
     scenes = {}
     for r in runs:

@@ -15,6 +15,14 @@ if(TARGET nhdyn_tool)
             -DOUT=${CMAKE_CURRENT_BINARY_DIR}/simulate_cli_paper -DEXPECT_RC=0
             "-DEXPECT_TEXT=paper-factorial: 16/16 succeeded" "-DEXPECT_TEXT2=paper-noise: 16/16 succeeded"
             -DEXPECT_SUCCESSES=33 -P ${_sim_check})
+  # Any robot: the shipped mobile manipulator's robot file, columns named from its URDF.
+  if(TARGET nhdyn::urdf)
+    add_test(NAME simulate_cli_mobile_manipulator
+      COMMAND ${CMAKE_COMMAND} -DTOOL=$<TARGET_FILE:nhdyn_tool> -DSCENE=mobile-manipulator-circle
+              -DRUN=mobile-manipulator-circle -DOUT=${CMAKE_CURRENT_BINARY_DIR}/simulate_cli_mm -DEXPECT_RC=0
+              "-DEXPECT_TEXT=mobile-manipulator-circle: 1/1 succeeded"
+              "-DEXPECT_HEADER_START=t,q_base_x,q_base_y,q_base_yaw,q_wheel_left_joint," -P ${_sim_check})
+  endif()
   # No NHDYN_SCENES_DIR: the tool finds its shipped scenes from its own location
   # (<build>/bin/nhdyn, <build>/share/nhdyn/scenes), from the test's folder (the build folder).
 endif()

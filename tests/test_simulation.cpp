@@ -288,3 +288,62 @@ TEST_CASE("simulation: CSV numbers read back bit for bit") {
   CHECK(i == r.rows.rows());
   std::filesystem::remove(path);
 }
+
+TEST_CASE("scene: Monte Carlo studies draw each run from its own seed, and a run replays alone from it") {
+  const std::string base = R"("base": "paper-circle", "set": {"duration": 1.5, "success": {"tail_from": 1, "max_tail_error": 1}})";
+  const auto study = [&](const std::string& mc) {
+    const auto j = scene::json::parse(R"({"name": "mc", "study": {)" + base + R"(, "monte_carlo": )" + mc + R"(,
+      "factors": [{"name": "m3", "path": "/plant/mass_factor/2", "distribution": {"uniform": [0.8, 1.2]}},
+                  {"name": "d3", "path": "/plant/d3_factor", "distribution": {"normal": [1, 0.02]}},
+                  {"name": "seed", "path": "/noise/seed", "distribution": {"integer": [1, 1000]}},
+                  {"name": "K1", "path": "/controller/K1", "distribution": {"choice": [30, 40, 50]}}]}})");
+    return scene::expand(j, {std::string(NHDYN_SOURCE_DIR) + "/examples/scenes"});
+  };
+  const auto a = study(R"({"runs": 12, "seed": 7})"), b = study(R"({"runs": 12, "seed": 7})"), c = study(R"({"runs": 12, "seed": 8})");
+  REQUIRE(a.size() == 12);
+  CHECK(a[0].name == "mc-00");
+  CHECK(a[11].name == "mc-11");
+  std::set<std::uint64_t> seeds;
+  int differ = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    REQUIRE(a[k].run_seed);
+    seeds.insert(*a[k].run_seed);
+    CHECK(a[k].factors == b[k].factors);  // deterministic
+    differ += a[k].factors != c[k].factors;
+    CHECK(a[k].plant.mass_factor[2] >= 0.8);
+    CHECK(a[k].plant.mass_factor[2] <= 1.2);
+    CHECK(a[k].seed >= 1);
+    CHECK(a[k].seed <= 1000);
+    CHECK((a[k].gains.K1(0, 0) == 30 || a[k].gains.K1(0, 0) == 40 || a[k].gains.K1(0, 0) == 50));
+  }
+  CHECK(seeds.size() == 12);
+  CHECK(differ == 12);
+  // run 5 alone, from its seed: the same factors, the same simulation bit for bit
+  const auto r = study(R"({"replay": [)" + std::to_string(*a[5].run_seed) + "]}");
+  REQUIRE(r.size() == 1);
+  CHECK(r[0].name == "mc-seed_" + std::to_string(*a[5].run_seed));
+  CHECK(r[0].factors == a[5].factors);
+  const run_result x = simulate(a[5]), y = simulate(r[0]);
+  REQUIRE(x.success);
+  CHECK(x.rows.rows() == y.rows.rows());
+  CHECK((x.rows - y.rows).cwiseAbs().maxCoeff() == 0.0);
+  // the draws follow their distributions: 4000 uniform draws have mean (lo+hi)/2 within 4σ
+  const auto many = scene::expand(scene::json::parse(R"({"name": "u", "study": {)" + base + R"(, "monte_carlo": {"runs": 4000},
+      "factors": [{"path": "/plant/d3_factor", "distribution": {"uniform": [0.5, 1.5]}}]}})"),
+                                  {std::string(NHDYN_SOURCE_DIR) + "/examples/scenes"});
+  double mean = 0;
+  for (const auto& s : many) mean += s.plant.d3_factor / double(many.size());
+  CHECK(std::abs(mean - 1.0) < 4 * std::sqrt(1.0 / 12 / 4000));
+  // errors name the field
+  const scene::search_path dirs{std::string(NHDYN_SOURCE_DIR) + "/examples/scenes"};
+  const auto bad = [&](const std::string& factors, const std::string& mc) {
+    return scene::json::parse(R"({"name": "bad", "study": {)" + base + R"(, "monte_carlo": )" + mc + R"(, "factors": )" + factors + "}}");
+  };
+  CHECK_THROWS_WITH(scene::expand(bad(R"([{"path": "/duration", "distribution": {"gamma": [1, 2]}}])", R"({"runs": 2})"), dirs),
+                    Catch::Contains("unknown distribution 'gamma'"));
+  CHECK_THROWS_WITH(scene::expand(bad(R"([{"path": "/duration", "levels": [1, 2]}])", R"({"runs": 2})"), dirs),
+                    Catch::Contains("levels"));
+  CHECK_THROWS_WITH(scene::expand(bad(R"([{"path": "/duration", "distribution": {"uniform": [2, 1]}}])", R"({"runs": 2})"), dirs),
+                    Catch::Contains("lo ≤ hi"));
+  CHECK_THROWS_WITH(scene::expand(bad(R"([])", R"({"runs": 0})"), dirs), Catch::Contains("monte_carlo.runs"));
+}

@@ -4,6 +4,7 @@
 /// figs. 4–6 (gnuplot), and prints a summary table. Exit status 1 if any run fails.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,9 @@
 #include <mutex>
 #include <nhdyn/simulation/batch.hpp>
 #include <nhdyn/simulation/scene.hpp>
+#ifdef NHDYN_TOOL_URDF
+#include <nhdyn/simulation/robot_scene.hpp>
+#endif
 #include <set>
 #include <sstream>
 
@@ -27,14 +31,18 @@ constexpr std::string_view usage = R"(nhdyn simulate SCENE... --out DIR [--threa
   share/nhdyn/scenes beside the tool's bin/ folder, or from $NHDYN_SCENES_DIR) and writes
   into DIR (created):
     DIR/<run>.csv       t,q1..q5,eta1..eta4,tau1..tau4,r_x,r_y,r_z,rd_x,rd_y,rd_z,err at the
-                        scene's output step, from dense output; tau is the torque applied
+                        scene's output step, from dense output (a robot file's scene:
+                        q_<joint>..., eta_<name>..., tau_<name>... by its names); tau is the torque applied
                         (the held value under zero-order hold), r the plant's true position,
                         err = |r_d - r|; numbers round-trip exact
-    DIR/summary.json    [{name, success, max_tail_error, steps, failure, wall_time_s, cpu_time_s, peak_tau}]
+    DIR/summary.json    {"runs": [{name, success, max_tail_error, steps, failure, wall_time_s,
+                        cpu_time_s, peak_tau, seed (Monte Carlo), factors (studies), rank, host}],
+                        "aggregate": {count, succeeded, success_rate, max_tail_error and
+                        peak_tau percentiles (min, p5, p50, p95, max), wall_time_s, cpu_time_s}}
     DIR/<group>-path.png, -error.png, -q.png, -tau.png   figs. 4-6 and tau(t) (gnuplot; one
                         set per scene or study, each run one colour, named in the legend)
   A study's runs go in parallel on --threads workers (default: all cores), with a progress
-  bar when stderr is a terminal. Exit status: 0 all runs succeeded, 1 some run failed,
+  bar and an ETA when stderr is a terminal. Exit status: 0 all runs succeeded, 1 some run failed,
   2 bad command line.
 )";
 
@@ -45,8 +53,11 @@ struct group {
 
 /// gnuplot program for one group's figures (figs. 4–6 of the paper, and τ(t)). Every run is
 /// one line style throughout (colour and dash) and named in the legend by what sets it apart
-/// (its name without the group's prefix, e.g. "m3_1.1-d3_0.9-a4_1-a5_1").
-std::string gnuplot_program(const std::filesystem::path& dir, const group& g, const std::vector<std::string>& names) {
+/// (its name without the group's prefix, e.g. "m3_1.1-d3_0.9-a4_1-a5_1"). `columns`: the
+/// group's CSV columns; paper5's get the paper's figures, any other robot's the same four
+/// figures from its column names (path seen from above: r_x, r_y).
+std::string gnuplot_program(const std::filesystem::path& dir, const group& g, const std::vector<std::string>& names,
+                            const std::vector<std::string>& columns) {
   std::ostringstream p;
   const std::string prefix = (dir / g.name).string();
   const auto label = [&](const std::string& run) {
@@ -62,6 +73,39 @@ std::string gnuplot_program(const std::filesystem::path& dir, const group& g, co
   // Eight colours, then the same eight dashed, dotted…: every run of up to 40 its own line.
   p << "'\nn = words(files)\nstyle(i) = 1 + int((i - 1) / 8) % 5\nset grid\n";
   p << (many ? "set key outside right top vertical font ',8' title 'run'\n" : "set key top right\n");
+  const bool paper5 = columns == nhdyn::run_columns();
+  const auto col = [&](const std::string& name) {
+    for (std::size_t j = 0; j < columns.size(); ++j)
+      if (columns[j] == name) return int(j) + 1;
+    return 0;
+  };
+  if (!paper5) {  // any robot: the same figures, from the column names
+    p << "set output '" << prefix << "-path.png'\nset title '" << g.name << ": task point seen from above'\n"
+      << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset size ratio -1\n"
+      << "plot word(files,1) every ::1 using " << col("rd_x") << ":" << col("rd_y")
+      << " with lines dt 2 lw 2 lc rgb 'black' title 'r_d', \\\n  for [i=1:n] word(files,i) every ::1 using " << col("r_x")
+      << ":" << col("r_y") << " with lines lw 1 lc i dt style(i) title word(titles,i)\nset size noratio\n";
+    p << "set output '" << prefix << "-error.png'\nset title '" << g.name
+      << ": tracking error |r_d - r|'\nset xlabel 't [s]'\nset ylabel '|r_d - r| [m]'\nset logscale y\n"
+      << "plot for [i=1:n] word(files,i) every ::1 using 1:" << col("err") << " with lines lc i dt style(i) title word(titles,i)\n"
+      << "unset logscale y\n";
+    const auto grid = [&](const char* file, const char* what, const std::string& prefix_of) {
+      std::vector<int> cs;
+      for (std::size_t j = 0; j < columns.size(); ++j)
+        if (columns[j].rfind(prefix_of, 0) == 0) cs.push_back(int(j) + 1);
+      const int per_row = cs.size() > 4 ? 3 : 1, rows = (int(cs.size()) + per_row - 1) / per_row;
+      p << "set terminal pngcairo size " << (per_row > 1 ? 1400 : 900) << "," << std::max(400, 170 * rows)
+        << " noenhanced font ',9'\nset output '" << prefix << file << "'\nset multiplot layout " << rows << "," << per_row
+        << " title '" << g.name << ": " << what << "'\nunset title\nset xlabel ''\nset key off\n";
+      for (int c : cs)
+        p << "set ylabel '" << columns[std::size_t(c - 1)].substr(prefix_of.size()) << "'\nplot for [i=1:n] word(files,i) every ::1 using 1:"
+          << c << " with lines lc i dt style(i)\n";
+      p << "unset multiplot\nset key\n";
+    };
+    grid("-q.png", "joint coordinates q (t)", "q_");
+    grid("-tau.png", "actuator forces and torques applied (t)", "tau_");
+    return p.str();
+  }
   p << "set output '" << prefix << "-path.png'\nset title '" << g.name
     << ": path in the ground plane (fig. 4), seen from above; dotted: base point (q2, q1)'\n"
        "set xlabel 'y0 [m]'\nset ylabel 'z0 [m]'\nset size ratio -1\n"
@@ -96,10 +140,19 @@ std::string gnuplot_program(const std::filesystem::path& dir, const group& g, co
   return p.str();
 }
 
-void plot(const std::filesystem::path& dir, const std::vector<group>& groups, const std::vector<std::string>& names) {
+void plot(const std::filesystem::path& dir, const std::vector<group>& groups, const std::vector<std::string>& names,
+          const std::vector<nhdyn::run_result>& results) {
   for (const auto& g : groups) {
+    if (g.runs.empty()) continue;
+    const auto& columns = results[g.runs.front()].columns;
+    bool same = !columns.empty();
+    for (auto i : g.runs) same = same && results[i].columns == columns;
+    if (!same) {
+      std::cerr << "nhdyn simulate: figures for '" << g.name << "' not made (its runs have different columns or failed to start)\n";
+      continue;
+    }
     const auto script = dir / (g.name + ".gp");
-    std::ofstream(script) << gnuplot_program(dir, g, names);
+    std::ofstream(script) << gnuplot_program(dir, g, names, columns);
     const std::string cmd = "gnuplot '" + script.string() + "' 2>&1";
     if (FILE* pipe = popen(cmd.c_str(), "r")) {
       std::string out;
@@ -175,6 +228,11 @@ int run(const std::vector<std::string>& args) {
   std::mutex m;
   std::size_t done = 0;
   const auto t0 = std::chrono::steady_clock::now();
+#ifdef NHDYN_TOOL_URDF
+  const auto runner = &nhdyn::simulate_scene;  // paper5 and robot files
+#else
+  const auto runner = &nhdyn::simulate;  // paper5 only (robot files need URDF support)
+#endif
   auto results = nhdyn::run_batch(specs, unsigned(threads), [&](std::size_t i, nhdyn::run_result& r) {
     const auto tc = std::chrono::steady_clock::now();
     const double cpu0 = nhdyn::detail::thread_cpu_seconds();
@@ -191,16 +249,25 @@ int run(const std::vector<std::string>& args) {
     ++done;
     if (tty) {
       const int width = 30, filled = int(double(width) * double(done) / double(specs.size()));
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const double eta = elapsed / double(done) * double(specs.size() - done);
       std::cerr << "\r[" << std::string(std::size_t(filled), '#') << std::string(std::size_t(width - filled), ' ')
-                << "] " << done << "/" << specs.size() << "  " << specs[i].name << "\033[K" << std::flush;
+                << "] " << done << "/" << specs.size() << "  " << fixed(elapsed, 0) << " s, ETA " << fixed(eta, 0) << " s  "
+                << specs[i].name << "\033[K" << std::flush;
     }
-  });
+  }, runner);
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (tty) std::cerr << "\r\033[K" << std::flush;
 
   // summary.json and the table.
-  nlohmann::ordered_json summary = nlohmann::ordered_json::array();
-  for (const auto& r : results) {
+  char host_buf[256] = {};
+  const std::string host = gethostname(host_buf, sizeof host_buf - 1) == 0 ? host_buf : "unknown";
+  nlohmann::ordered_json runs = nlohmann::ordered_json::array();
+  std::vector<double> tails, peaks;
+  int succeeded = 0;
+  double cpu_sum = 0;
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const auto& r = results[i];
     nlohmann::ordered_json e;
     e["name"] = r.name;
     e["success"] = r.success;
@@ -210,8 +277,44 @@ int run(const std::vector<std::string>& args) {
     e["wall_time_s"] = r.wall_time_s;
     e["cpu_time_s"] = r.cpu_time_s;
     e["peak_tau"] = r.peak_tau;
-    summary.push_back(e);
+    if (specs[i].run_seed) e["seed"] = *specs[i].run_seed;
+    if (!specs[i].factors.empty()) e["factors"] = nlohmann::ordered_json::parse(specs[i].factors);
+    e["rank"] = 0;  // the process that ran it (0: no MPI)
+    e["host"] = host;
+    runs.push_back(e);
+    succeeded += r.success;
+    cpu_sum += r.cpu_time_s;
+    if (std::isfinite(r.max_tail_error)) tails.push_back(r.max_tail_error);
+    peaks.push_back(r.peak_tau);
   }
+  const auto percentiles = [](std::vector<double> v) {
+    nlohmann::ordered_json p;
+    if (v.empty()) return nlohmann::ordered_json(nullptr);
+    std::sort(v.begin(), v.end());
+    const auto at = [&](double f) {  // linear interpolation between order statistics
+      const double x = f * double(v.size() - 1);
+      const std::size_t k = std::size_t(x);
+      return k + 1 < v.size() ? v[k] + (x - double(k)) * (v[k + 1] - v[k]) : v[k];
+    };
+    p["min"] = v.front();
+    p["p5"] = at(0.05);
+    p["p50"] = at(0.5);
+    p["p95"] = at(0.95);
+    p["max"] = v.back();
+    return p;
+  };
+  nlohmann::ordered_json aggregate;
+  aggregate["count"] = results.size();
+  aggregate["succeeded"] = succeeded;
+  aggregate["success_rate"] = results.empty() ? 0.0 : double(succeeded) / double(results.size());
+  aggregate["max_tail_error"] = percentiles(tails);
+  aggregate["peak_tau"] = percentiles(peaks);
+  aggregate["wall_time_s"] = total;
+  aggregate["cpu_time_s"] = cpu_sum;
+  aggregate["processes"] = 1;
+  nlohmann::ordered_json summary;
+  summary["runs"] = runs;
+  summary["aggregate"] = aggregate;
   {
     std::ofstream f(dir / "summary.json");
     f << summary.dump(2) << '\n';
@@ -243,7 +346,7 @@ int run(const std::vector<std::string>& args) {
   std::cout << "total: " << int(results.size()) - failed << "/" << results.size() << " succeeded in "
             << fixed(total, 2) << " s wall, " << fixed(cpu, 2) << " s cpu (" << (threads ? unsigned(threads) : std::thread::hardware_concurrency())
             << " threads); files in " << dir.string() << '\n';
-  if (!no_plots) plot(dir, groups, names);
+  if (!no_plots) plot(dir, groups, names, results);
   return failed ? 1 : 0;
 }
 }  // namespace

@@ -21,14 +21,17 @@ namespace nhdyn {
 /// workers (write that run's files there; guard shared state such as a progress bar);
 /// results come back in the order of `specs`. A
 /// spec that cannot be set up (bad model) becomes a failed run with the error as reason.
-template <class OnDone>
-std::vector<run_result> run_batch(const std::vector<run_spec>& specs, unsigned threads, OnDone&& on_done) {
+/// `run(spec)` simulates one spec: `simulate` (paper5, the default) or `simulate_scene`
+/// (any robot, simulation/robot_scene.hpp).
+template <class OnDone, class Run = run_result (*)(const run_spec&)>
+std::vector<run_result> run_batch(const std::vector<run_spec>& specs, unsigned threads, OnDone&& on_done,
+                                  Run run = &simulate) {
   std::vector<run_result> results(specs.size());
   std::atomic<std::size_t> next{0};
   const auto worker = [&] {
     for (std::size_t i; (i = next.fetch_add(1)) < specs.size();) {
       try {
-        results[i] = simulate(specs[i]);
+        results[i] = run(specs[i]);
       } catch (const std::exception& e) {
         results[i].name = specs[i].name;
         results[i].success = false;

@@ -1,7 +1,8 @@
 #pragma once
 /// \file simulation/controller.hpp
 /// The paper's robust task-space controller (paper.md §3, Salazar-Silva et al. §V) for a
-/// point r ∈ R³ on the last link, as paper5.md uses it:
+/// point r ∈ R³ on any body of any model (a DH chain or a kinematic tree) with any
+/// constraint; paper5.md uses it with r the origin of paper5's last link:
 ///
 ///     r̃ = r_d − r,  dr̃/dt = ṙ_d − B η,  e = (r̃, dr̃/dt) ∈ R⁶,  H = [0; −I₃]
 ///     δ   = −ρ(e) Hᵀ P e / max(‖Hᵀ P e‖, ε)   (0 where Hᵀ P e = 0)        (eq. 23–28)
@@ -11,7 +12,7 @@
 ///     z   = −k_N η − k_P Sᵀ W (q − q_posture)    (W selects the posture joints)
 ///     τ   = (SᵀS)⁻¹ Sᵀ rne_nominal(q, Sη, Sa + Ṡη)                              (eq. 21)
 ///
-/// with B = J_v(q) S(q) (3×m, eq. 29), Ḃη = J̇q̇ + J_v Ṡ η at q̇ = Sη, and P the solution of
+/// with B = J_v(q) S(q) (3×m, eq. 29; J_v the point's translational Jacobian), Ḃη = J̇q̇ + J_v Ṡ η at q̇ = Sη, and P the solution of
 /// the Lyapunov equation A_cᵀP + PA_c = −I₆, A_c = [0 I; −K₀ −K₁]. ε = 0 is the paper's
 /// discontinuous unit vector; ε > 0 the boundary-layer variant. For paper5's posture term
 /// (0, 0, q₄ − q₄(0), q₅ − q₅(0)) W = diag(0, 0, 0, 1, 1): Sᵀ maps it to η's slots.
@@ -22,11 +23,15 @@
 ///
 ///     nhdyn::rac_controller ctrl(nominal.chain, nominal.constraint, gains, q0, mask);
 ///     Eigen::Vector4d tau = ctrl(q, eta, r_measured, circle(t));
+///     // any tree and constraint, the point p on body i (1-based, as tree_kinematics):
+///     nhdyn::rac_controller arm(tree, c, gains, q0, mask, i, p);
 #include <Eigen/Dense>
 
 #include "../constraints/stages.hpp"
 #include "../detail/ldlt.hpp"
+#include "../dynamics/tree.hpp"
 #include "../kinematics/kinematics.hpp"
+#include "../kinematics/tree.hpp"
 
 namespace nhdyn {
 
@@ -94,22 +99,42 @@ inline Eigen::Matrix<double, 6, 6> lyapunov_P(const Eigen::Matrix3d& K0, const E
   return P;
 }
 
-template <class S, int N, class C>
+namespace detail {
+template <class S, int N>
+kinematics<S, N> kinematics_of(const chain<S, N>& c) {
+  return kinematics<S, N>(c);
+}
+template <class S>
+tree_kinematics<S> kinematics_of(const tree<S>& t) {
+  return tree_kinematics<S>(t);
+}
+}  // namespace detail
+
+/// Model: chain<S, N> (the default) or tree<S> (N = dynamic).
+template <class S, int N, class C, class Model = chain<S, N>>
 class rac_controller {
  public:
   static constexpr int M = C::m_at_compile_time;
 
   /// nominal: the controller's model; posture_mask: 1 for joints the posture term holds at
-  /// q_posture (paper5: joints 4 and 5), 0 elsewhere; task_link: the link carrying r (its
-  /// frame origin; default the last).
-  rac_controller(const chain<S, N>& nominal, C c, rac_gains g, vecN<double, N> q_posture,
-                 vecN<double, N> posture_mask, int task_link = -1)
-      : c_(c), kin_(nominal), id_(inverse_dynamics(nominal, c)), g_(std::move(g)),
+  /// q_posture (paper5: joints 4 and 5), 0 elsewhere; task_body: the link or body carrying r
+  /// (1…n as the kinematics number them; default the last), task_point: r on it, in its frame.
+  rac_controller(const Model& nominal, C c, rac_gains g, vecN<double, N> q_posture, vecN<double, N> posture_mask,
+                 int task_body = -1, const vec3<S>& task_point = vec3<S>::Zero())
+      : c_(c), kin_(detail::kinematics_of(nominal)), id_(inverse_dynamics(nominal, c)), g_(std::move(g)),
         P_(lyapunov_P(g_.K0, g_.K1)), q_posture_(std::move(q_posture)), mask_(std::move(posture_mask)),
-        link_(task_link < 0 ? nominal.dof() : task_link) {
+        link_(task_body < 0 ? nominal.dof() : task_body), point_(task_point) {
     if (!(g_.lambda >= 0) || !(g_.kN >= 0) || !(g_.kP >= 0) || !(g_.robust.epsilon >= 0) ||
         !(g_.robust.alpha >= 0 && g_.robust.alpha < 1))
       throw input_error("controller gains: need λ, k_N, k_P, ε ≥ 0 and 0 ≤ α < 1");
+    const int n = nominal.dof();
+    if (q_posture_.size() != n || mask_.size() != n)
+      throw input_error("controller: the posture and its mask need " + std::to_string(n) + " entries (one per joint)");
+    if (c_.dof() != n)
+      throw input_error("controller: the constraint is for " + std::to_string(c_.dof()) + " coordinates, the model has " +
+                        std::to_string(n));
+    if (link_ < 1 || link_ > n) throw input_error("controller: task body " + std::to_string(link_) + " is not in 1…" + std::to_string(n));
+    if (!point_.allFinite()) throw input_error("controller: the task point is not finite");
   }
   const Eigen::Matrix<double, 6, 6>& P() const { return P_; }
   const rac_gains& gains() const { return g_; }
@@ -134,10 +159,10 @@ class rac_controller {
   vecN<T, M> operator()(const vecN<T, N>& q, const vecN<T, M>& eta, const vec3<T>& r,
                         const task_reference<T>& ref) const {
     const vecN<T, N> qd = apply_S(c_, q, eta);
-    const Eigen::Matrix<T, 3, N> Jv = kin_.jacobian(q, link_).template topRows<3>();
+    const Eigen::Matrix<T, 3, N> Jv = kin_.jacobian(q, link_, point_).template topRows<3>();
     const auto Sq = c_.S(q);
     const Eigen::Matrix<T, 3, M> B = Jv * Sq;                                       // eq. 29
-    const vec3<T> Bdot_eta = kin_.jdot_qdot(q, qd, link_).linear + Jv * apply_Sdot(c_, q, qd, eta);
+    const vec3<T> Bdot_eta = kin_.jdot_qdot(q, qd, link_, point_).linear + Jv * apply_Sdot(c_, q, qd, eta);
     Eigen::Matrix<T, 6, 1> e;
     e << ref.r - r, ref.rd - B * eta;
     const vec3<T> a_r = ref.rdd + g_.K1.template cast<T>() * e.template tail<3>() +
@@ -155,7 +180,7 @@ class rac_controller {
   /// The task point r(q) on the controller's model.
   template <class T>
   vec3<T> task_point(const vecN<T, N>& q) const {
-    return kin_.point(q, link_);
+    return kin_.point(q, link_, point_);
   }
 
   /// The singular values of B(q) = J_v(q) S(q) (eq. 29), largest first, in double: how far
@@ -163,18 +188,24 @@ class rac_controller {
   /// produced). With λ > 0 the damped B⁺ keeps its gain σ/(σ² + λ²) ≤ 1/(2λ) there; with
   /// λ = 0 the controller throws numerical_error at a singular B instead of dividing by 0.
   Eigen::Vector3d task_singular_values(const vecN<double, N>& q) const {
-    const Eigen::Matrix<double, 3, M> B = kin_.jacobian(q, link_).template topRows<3>() * c_.S(q);
+    const Eigen::Matrix<double, 3, M> B = kin_.jacobian(q, link_, point_).template topRows<3>() * c_.S(q);
     return Eigen::JacobiSVD<Eigen::Matrix<double, 3, M>>(B).singularValues().template head<3>();
   }
 
  private:
   C c_;
-  kinematics<S, N> kin_;
-  decltype(inverse_dynamics(std::declval<const chain<S, N>&>(), std::declval<const C&>())) id_;
+  decltype(detail::kinematics_of(std::declval<const Model&>())) kin_;
+  decltype(inverse_dynamics(std::declval<const Model&>(), std::declval<const C&>())) id_;
   rac_gains g_;
   Eigen::Matrix<double, 6, 6> P_;
   vecN<double, N> q_posture_, mask_;
   int link_;
+  vec3<S> point_;
 };
+
+template <class S, int N, class C, class... A>
+rac_controller(const chain<S, N>&, C, A...) -> rac_controller<S, N, C>;
+template <class S, class C, class... A>
+rac_controller(const tree<S>&, C, A...) -> rac_controller<S, dynamic, C, tree<S>>;
 
 }  // namespace nhdyn

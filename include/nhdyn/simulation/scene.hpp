@@ -5,13 +5,16 @@
 /// numbers (paper5.md). Unknown fields are errors naming the field ("scene 'x': unknown
 /// field 'controller.K2'"), so a typo never falls back to a default silently.
 ///
-///     scene  = {"name", "description", "robot": "paper5", "plant": factors, "model": factors,
+///     scene  = {"name", "description", "robot": "paper5" | robot file, "task": {"frame", "point"},
+///               "plant": factors, "model": factors,
 ///               "controller": {...}, "reference": {...}, "initial": {"q", "eta"},
 ///               "integrator": {...}, "duration", "sampling": {...}, "noise": {...},
 ///               "output": {"step"}, "success": {"tail_from", "max_tail_error"}}
 ///     study  = {"name", "description", "study": {"base": scene | "scene name",
 ///               "set": {JSON merge patch}, "factors": [{"name", "path", "levels"}]}}
-///               → the full factorial over the factors' levels (path: a JSON pointer)
+///               → the full factorial over the factors' levels (path: a JSON pointer), or
+///               with "monte_carlo": {"runs", "seed"} | {"replay": [seeds]} and factors
+///               [{"name", "path", "distribution"}]: runs drawn each from its own seed
 ///     suite  = {"name", "description", "scenes": [scene | study | suite | "name", …]}
 ///
 ///     auto f = nhdyn::scene::open("paper-factorial");   // a shipped scene, or a file path
@@ -20,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <sstream>
 
 #include "../io/json.hpp"
@@ -106,20 +110,72 @@ inline presets::paper5_parameters<double> read_factors(const object& o) {
 constexpr std::initializer_list<const char*> factor_keys = {"mass_factor", "d3_factor", "a4_factor", "a5_factor"};
 }  // namespace detail
 
-/// One run from a scene object (see the file comment).
-inline run_spec parse_run(const json& j) {
+/// The shipped robot files' folder: `share/nhdyn/robots` beside the scenes' (robot names in
+/// scenes are looked up there after the scene file's own folder).
+inline std::filesystem::path shipped_robots_dir(const std::vector<std::filesystem::path>& scene_dirs) {
+  for (auto it = scene_dirs.rbegin(); it != scene_dirs.rend(); ++it)
+    if (it->filename() == "scenes") return it->parent_path() / "robots";
+  return {};
+}
+
+/// One run from a scene object (see the file comment). `dirs`: where a robot file it names
+/// is looked for (the scene file's folder first).
+inline run_spec parse_run(const json& j, const std::vector<std::filesystem::path>& dirs = {}) {
   const std::string name = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : "";
   const std::string where = "scene '" + (name.empty() ? "(unnamed)" : name) + "': ";
   const detail::object o(j, where, "",
-                         {"name", "description", "robot", "plant", "model", "controller", "reference", "initial",
-                          "integrator", "duration", "sampling", "noise", "output", "success"});
+                         {"name", "description", "robot", "task", "plant", "model", "controller", "reference",
+                          "initial", "integrator", "duration", "sampling", "noise", "output", "success"});
   run_spec s;
   if (name.empty()) throw input_error(where + "field 'name' (a string) is required");
   s.name = name;
-  if (const auto robot = o.text("robot", "paper5"); robot != "paper5")
-    throw input_error(where + "field 'robot': only the preset 'paper5' is simulated (got '" + robot + "')");
-  if (o.has("plant")) s.plant = detail::read_factors(o.sub("plant", detail::factor_keys));
-  if (o.has("model")) s.model = detail::read_factors(o.sub("model", detail::factor_keys));
+  const std::string robot = o.text("robot", "paper5");
+  const bool paper5 = robot == "paper5";
+  if (!paper5) {  // a robot file: a path (relative to the scene's folder) or a shipped robot's name
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    std::vector<fs::path> tries;
+    if (fs::path(robot).is_absolute()) tries.emplace_back(robot);
+    for (const auto& d : dirs) tries.push_back(d / robot);
+    if (const auto r = shipped_robots_dir(dirs); !r.empty()) tries.push_back(r / (robot + ".json"));
+    for (const auto& t : tries)
+      if (fs::is_regular_file(t, ec)) {
+        s.robot = t.string();
+        break;
+      }
+    if (s.robot == "paper5") {
+      std::string looked;
+      for (const auto& t : tries) looked += (looked.empty() ? "" : ", ") + t.string();
+      throw input_error(where + "field 'robot': '" + robot + "' is neither 'paper5' nor a robot file (looked for " +
+                        (looked.empty() ? std::string("nothing: no folder") : looked) + ")");
+    }
+    const auto task = o.sub("task", {"frame", "point"});
+    if (!task.has("frame")) throw input_error(where + "field 'task.frame' (a body or frame name carrying r) is required for robot '" + robot + "'");
+    s.task_frame = task.text("frame", "");
+    if (task.has("point")) s.task_point = task.vector("point", 3);
+    const auto masses = [&](const char* k) {
+      std::vector<std::pair<std::string, double>> out;
+      if (!o.has(k)) return out;
+      const auto f = o.sub(k, {"mass_factor"});
+      if (!f.has("mass_factor")) return out;
+      const json& mf = f.j.at("mass_factor");
+      if (!mf.is_object())
+        throw input_error(where + "field '" + std::string(k) + ".mass_factor' must be an object {\"BODY\": factor, …} for robot files");
+      for (auto it = mf.begin(); it != mf.end(); ++it) {
+        if (!it->is_number() || !(it->get<double>() > 0) || !std::isfinite(it->get<double>()))
+          throw input_error(where + "field '" + std::string(k) + ".mass_factor." + it.key() + "' must be a finite number > 0");
+        out.emplace_back(it.key(), it->get<double>());
+      }
+      return out;
+    };
+    s.plant_mass = masses("plant");
+    s.model_mass = masses("model");
+    s.plant = s.model = presets::paper5_parameters<double>{};  // not used: no paper5 factors
+  } else {
+    if (o.has("task")) throw input_error(where + "field 'task': paper5's task point is the origin of link 5 (not settable)");
+    if (o.has("plant")) s.plant = detail::read_factors(o.sub("plant", detail::factor_keys));
+    if (o.has("model")) s.model = detail::read_factors(o.sub("model", detail::factor_keys));
+  }
 
   const auto c = o.sub("controller", {"K0", "K1", "lambda", "kN", "kP", "posture_joints", "robust"});
   s.gains.K0 = c.gain("K0", s.gains.K0);
@@ -127,7 +183,14 @@ inline run_spec parse_run(const json& j) {
   s.gains.lambda = c.number("lambda", s.gains.lambda);
   s.gains.kN = c.number("kN", s.gains.kN);
   s.gains.kP = c.number("kP", s.gains.kP);
-  if (c.has("posture_joints")) {
+  if (c.has("posture_joints") && !paper5) {
+    const json& pj = c.j.at("posture_joints");
+    if (!pj.is_array()) throw input_error(where + "field 'controller.posture_joints' must be a list of joint names");
+    for (const auto& k : pj) {
+      if (!k.is_string()) throw input_error(where + "field 'controller.posture_joints': entries are joint names");
+      s.posture_joints.push_back(k.get<std::string>());
+    }
+  } else if (c.has("posture_joints")) {
     const json& pj = c.j.at("posture_joints");
     if (!pj.is_array()) throw input_error(where + "field 'controller.posture_joints' must be a list of joint numbers 1…5");
     s.posture_mask.setZero();
@@ -155,8 +218,18 @@ inline run_spec parse_run(const json& j) {
   s.reference.phase = r.number("phase", 0);
 
   const auto init = o.sub("initial", {"q", "eta"});
-  if (init.has("q")) s.q0 = init.vector("q", 5);
-  if (init.has("eta")) s.eta0 = init.vector("eta", 4);
+  if (paper5) {
+    if (init.has("q")) s.q0 = init.vector("q", 5);
+    if (init.has("eta")) s.eta0 = init.vector("eta", 4);
+  } else {  // the sizes are the robot's, checked when it is loaded
+    const auto list = [&](const char* k) {
+      const json& v = init.j.at(k);
+      if (!v.is_array()) throw input_error(where + "field 'initial." + std::string(k) + "' must be a list of numbers");
+      return init.vector(k, int(v.size()));
+    };
+    if (init.has("q")) s.q_start = list("q");
+    if (init.has("eta")) s.eta_start = list("eta");
+  }
 
   const auto in = o.sub("integrator", {"method", "step", "rtol", "atol", "max_steps", "min_step"});
   s.integrator.kind = method_from_string(in.text("method", to_string(s.integrator.kind)));
@@ -274,6 +347,69 @@ inline std::string level_text(const json& v) {
   return v.is_string() ? v.get<std::string>() : v.dump();
 }
 
+/// Run k's seed in a Monte Carlo study seeded with `seed`: splitmix64 of seed + k, so that
+/// runs are independent streams and any one is reproduced from its seed alone.
+inline std::uint64_t run_seed(std::uint64_t seed, std::uint64_t k) {
+  std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (k + 1);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+/// A Monte Carlo factor's distribution (docs/simulation.md, "Monte Carlo studies"), drawn
+/// from std::mt19937_64 by formulas of its own (the standard library's distributions are
+/// implementation-defined): the same numbers on every platform.
+struct distribution {
+  enum kind_t { uniform, normal, lognormal, integer, choice } kind = uniform;
+  double a = 0, b = 1;
+  json levels;
+  json draw(std::mt19937_64& g) const {
+    const auto unit = [&] { return (double(g() >> 11) + 0.5) * 0x1.0p-53; };  // (0, 1)
+    const auto gauss = [&] { return std::sqrt(-2 * std::log(unit())) * std::cos(2 * 3.14159265358979323846 * unit()); };
+    switch (kind) {
+      case uniform: return a + (b - a) * unit();
+      case normal: return a + b * gauss();
+      case lognormal: return std::exp(a + b * gauss());
+      case integer: return std::int64_t(a) + std::int64_t(unit() * (b - a + 1));
+      case choice: return levels[std::size_t(unit() * double(levels.size()))];
+    }
+    return nullptr;
+  }
+};
+inline distribution read_distribution(const json& j, const std::string& where) {
+  if (!j.is_object() || j.size() != 1)
+    throw input_error(where + "must be one of {\"uniform\": [lo, hi]}, {\"normal\": [mean, sd]}, "
+                              "{\"lognormal\": [mu, sigma]}, {\"integer\": [lo, hi]}, {\"choice\": [values…]}");
+  const std::string k = j.begin().key();
+  const json& v = j.begin().value();
+  distribution d;
+  if (k == "choice") {
+    if (!v.is_array() || v.empty()) throw input_error(where + "'choice' needs a non-empty list of values");
+    d.kind = distribution::choice;
+    d.levels = v;
+    return d;
+  }
+  if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number() || !std::isfinite(v[0].get<double>()) ||
+      !std::isfinite(v[1].get<double>()))
+    throw input_error(where + "'" + k + "' needs two finite numbers");
+  d.a = v[0].get<double>();
+  d.b = v[1].get<double>();
+  if (k == "uniform") {
+    d.kind = distribution::uniform;
+    if (!(d.a <= d.b)) throw input_error(where + "'uniform': needs lo ≤ hi");
+  } else if (k == "normal" || k == "lognormal") {
+    d.kind = k == "normal" ? distribution::normal : distribution::lognormal;
+    if (!(d.b >= 0)) throw input_error(where + "'" + k + "': the spread must be ≥ 0");
+  } else if (k == "integer") {
+    d.kind = distribution::integer;
+    if (d.a != std::floor(d.a) || d.b != std::floor(d.b) || !(d.a <= d.b) || std::abs(d.a) > 9e15 || std::abs(d.b) > 9e15)
+      throw input_error(where + "'integer': needs integers lo ≤ hi");
+  } else {
+    throw input_error(where + "unknown distribution '" + k + "' (known: uniform, normal, lognormal, integer, choice)");
+  }
+  return d;
+}
+
 /// A scene named inside a scene file: a path relative to that file's folder (dirs' first),
 /// or a name looked up in dirs; never the current folder.
 inline opened open_nested(const std::string& ref, const search_path& dirs) {
@@ -309,7 +445,7 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth, co
     for (const auto& s : resolved["scenes"]) expand_into(s, out, depth + 1, dirs);
   } else if (resolved.contains("study")) {
     const object o(resolved, where, "", {"name", "description", "study"});
-    const object st = o.sub("study", {"base", "set", "factors"});
+    const object st = o.sub("study", {"base", "set", "factors", "monte_carlo"});
     if (!st.has("base")) throw input_error(where + "field 'study.base' is required");
     json base = st.j["base"].is_string() ? load(st.j["base"].get<std::string>(), dirs) : st.j["base"];
     if (!base.is_object() || base.contains("study") || base.contains("scenes"))
@@ -320,13 +456,21 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth, co
     }
     const json factors = st.has("factors") ? st.j["factors"] : json::array();
     if (!factors.is_array()) throw input_error(where + "field 'study.factors' must be a list");
+    const bool monte_carlo = st.has("monte_carlo");
     std::vector<std::size_t> level(factors.size(), 0);
+    std::vector<distribution> dists;
     for (std::size_t i = 0; i < factors.size(); ++i) {
-      const object f(factors[i], where, "study.factors[" + std::to_string(i) + "]", {"name", "path", "levels"});
-      if (!f.has("path") || !f.j["path"].is_string() || !f.has("levels") || !f.j["levels"].is_array() ||
-          f.j["levels"].empty())
-        throw input_error(where + "field 'study.factors[" + std::to_string(i) +
-                          "]' needs 'path' (a JSON pointer) and a non-empty list 'levels'");
+      const std::string fw = "study.factors[" + std::to_string(i) + "]";
+      const object f(factors[i], where, fw, {"name", "path", monte_carlo ? "distribution" : "levels"});
+      if (!f.has("path") || !f.j["path"].is_string())
+        throw input_error(where + "field '" + fw + "' needs 'path' (a JSON pointer)");
+      if (monte_carlo) {
+        if (!f.has("distribution"))
+          throw input_error(where + "field '" + fw + "' needs 'distribution' in a Monte Carlo study");
+        dists.push_back(read_distribution(f.j["distribution"], where + "field '" + fw + ".distribution': "));
+      } else if (!f.has("levels") || !f.j["levels"].is_array() || f.j["levels"].empty()) {
+        throw input_error(where + "field '" + fw + "' needs a non-empty list 'levels'");
+      }
       // A JSON pointer may index an array past its end (it grows): bound the index so that a
       // typo like /x/100000000000 is an error, not an attempt to allocate it.
       const std::string p = f.j["path"].get<std::string>();
@@ -339,6 +483,55 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth, co
         a = b;
       }
     }
+    const auto set_factor = [&](json& run, std::size_t i, const json& v) {
+      try {
+        run[json::json_pointer(factors[i]["path"].get<std::string>())] = v;
+      } catch (const json::exception& e) {
+        throw input_error(where + "field 'study.factors[" + std::to_string(i) + "].path': " + e.what());
+      }
+    };
+    const auto factor_name = [&](std::size_t i) {
+      const auto& f = factors[i];
+      return f.contains("name") && f["name"].is_string() ? f["name"].get<std::string>() : f["path"].get<std::string>();
+    };
+    if (monte_carlo) {  // run i: its own seed, its factors drawn from it in order
+      const object mc = st.sub("monte_carlo", {"runs", "seed", "replay"});
+      std::vector<std::uint64_t> seeds;
+      const auto seed_of = [&](const json& v, const std::string& field) {
+        if (!v.is_number_integer() || (!v.is_number_unsigned() && v.get<long long>() < 0))
+          throw input_error(where + "field '" + field + "' must be a non-negative integer");
+        return v.get<std::uint64_t>();
+      };
+      if (mc.has("replay")) {  // the runs of these seeds only (a run replayed alone)
+        if (!mc.j["replay"].is_array() || mc.j["replay"].empty())
+          throw input_error(where + "field 'study.monte_carlo.replay' must be a non-empty list of run seeds");
+        for (const auto& v : mc.j["replay"]) seeds.push_back(seed_of(v, "study.monte_carlo.replay"));
+      } else {
+        const double n = mc.number("runs", 0);
+        if (!(n >= 1 && n <= 1e6 && n == std::floor(n)))
+          throw input_error(where + "field 'study.monte_carlo.runs' must be an integer in 1…1000000");
+        const std::uint64_t seed = mc.has("seed") ? seed_of(mc.j["seed"], "study.monte_carlo.seed") : 1;
+        for (std::uint64_t k = 0; k < std::uint64_t(n); ++k) seeds.push_back(run_seed(seed, k));
+      }
+      const int width = int(std::to_string(seeds.size() - 1).size());
+      for (std::size_t k = 0; k < seeds.size(); ++k) {
+        json run = base;
+        json drawn = json::object();
+        std::mt19937_64 g(seeds[k]);
+        for (std::size_t i = 0; i < factors.size(); ++i) {
+          const json v = dists[i].draw(g);
+          set_factor(run, i, v);
+          drawn[factor_name(i)] = v;
+        }
+        std::string idx = std::to_string(k);
+        idx.insert(0, std::size_t(width) - std::min(idx.size(), std::size_t(width)), '0');
+        run["name"] = name + (mc.has("replay") ? "-seed_" + std::to_string(seeds[k]) : "-" + idx);
+        out.push_back(parse_run(run, dirs));
+        out.back().run_seed = seeds[k];
+        out.back().factors = drawn.dump();
+      }
+      return;
+    }
     double runs = 1;
     for (const auto& f : factors) runs *= double(f["levels"].size());
     if (runs > 1e5)
@@ -347,21 +540,19 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth, co
     for (bool more = true; more;) {
       json run = base;
       std::string run_name = name;
+      json levels = json::object();
       for (std::size_t i = 0; i < factors.size(); ++i) {
-        const auto& f = factors[i];
-        const json& v = f["levels"][level[i]];
-        try {
-          run[json::json_pointer(f["path"].get<std::string>())] = v;
-        } catch (const json::exception& e) {
-          throw input_error(where + "field 'study.factors[" + std::to_string(i) + "].path': " + e.what());
-        }
+        const json& v = factors[i]["levels"][level[i]];
+        set_factor(run, i, v);
+        levels[factor_name(i)] = v;
         run_name += '-';
-        run_name += f.contains("name") && f["name"].is_string() ? f["name"].get<std::string>() : f["path"].get<std::string>();
+        run_name += factor_name(i);
         run_name += '_';
         run_name += level_text(v);
       }
       run["name"] = run_name;
-      out.push_back(parse_run(run));
+      out.push_back(parse_run(run, dirs));
+      out.back().factors = levels.dump();
       more = false;
       for (std::size_t i = factors.size(); i-- > 0;) {
         if (++level[i] < factors[i]["levels"].size()) {
@@ -372,7 +563,7 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth, co
       }
     }
   } else {
-    out.push_back(parse_run(resolved));
+    out.push_back(parse_run(resolved, dirs));
   }
 }
 }  // namespace detail

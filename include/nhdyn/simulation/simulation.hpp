@@ -32,8 +32,20 @@
 
 namespace nhdyn {
 
+/// What a closed-loop run needs beside its plant, controller and reference: integration,
+/// sampling, noise, output and the success test (defaults: paper-circle's).
+struct run_options {
+  integrator_options integrator{method::dopri5, 2e-3, 1e-5, 1e-7};
+  double duration = 20;
+  double output_step = 0.01;
+  double sample_rate = 0;  ///< Hz; 0 = continuous control
+  double noise_sigma = 0;  ///< m, per coordinate of the measured r, per sample
+  std::uint64_t seed = 1;
+  double tail_from = 15, tail_tolerance = 0.01;  ///< success: max ‖r̃‖ over [tail_from, end] below this
+};
+
 /// Everything that defines one run (a scene, once parsed): defaults are paper-circle.
-struct run_spec {
+struct run_spec : run_options {
   std::string name = "paper-circle";
   presets::paper5_parameters<double> plant{{1.1, 1.1, 1.1, 1.1, 1.1}, 1, 1, 1};
   presets::paper5_parameters<double> model{};  ///< the controller's (nominal) model
@@ -43,13 +55,19 @@ struct run_spec {
   vecN<double, 5> q0 = (vecN<double, 5>() << -0.23710299623923958, 1.0, 3.141592653589793,
                         2.058145585963254, 1.2).finished();
   vecN<double, 4> eta0 = vecN<double, 4>::Zero();
-  integrator_options integrator{method::dopri5, 2e-3, 1e-5, 1e-7};
-  double duration = 20;
-  double output_step = 0.01;
-  double sample_rate = 0;  ///< Hz; 0 = continuous control
-  double noise_sigma = 0;  ///< m, per coordinate of the measured r, per sample
-  std::uint64_t seed = 1;
-  double tail_from = 15, tail_tolerance = 0.01;  ///< success: max ‖r̃‖ over [tail_from, end] below this
+
+  // Any robot (scene field "robot" other than "paper5"; simulation/robot_scene.hpp runs it).
+  // plant/model, q0, eta0 and posture_mask above are paper5's; for a robot file these are:
+  std::string robot = "paper5";  ///< "paper5", or a robot file's path
+  std::string task_frame;        ///< the body or frame carrying r
+  vec3<double> task_point = vec3<double>::Zero();  ///< r in that frame
+  Eigen::VectorXd q_start, eta_start;              ///< the initial state (empty: zeros)
+  std::vector<std::string> posture_joints;         ///< joints the posture term holds at q_start
+  std::vector<std::pair<std::string, double>> plant_mass, model_mass;  ///< mass factors by body name
+
+  // Where the run came from in a study (scene.hpp), for summary.json:
+  std::optional<std::uint64_t> run_seed;  ///< a Monte Carlo run's seed (replays it alone)
+  std::string factors;                    ///< the study's factor values for this run (a JSON object), or empty
 };
 
 /// Columns of a run's output rows (and CSV).
@@ -69,6 +87,7 @@ struct run_result {
   long steps = 0;                      ///< accepted integrator steps
   double wall_time_s = 0;
   double cpu_time_s = 0;  ///< CPU time of the simulating thread (what a loaded machine does not inflate)
+  std::vector<std::string> columns;  ///< the rows' column names (run_columns for paper5)
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows;  ///< one row per output time
 };
 
@@ -99,71 +118,108 @@ struct gaussian {
   }
 };
 
-inline std::string state_text(double t, const vecN<double, 9>& x) {
+template <class X>
+std::string state_text(double t, const X& x) {
   std::ostringstream os;
   os.precision(17);
   os << "at t = " << t << " s, state (q, η) = [";
-  for (int i = 0; i < 9; ++i) os << (i ? ", " : "") << x(i);
+  for (int i = 0; i < int(x.size()); ++i) os << (i ? ", " : "") << x(i);
   return os.str() + "]";
 }
 }  // namespace detail
 
-/// Runs one scene. Never throws for a failing simulation: the result says why it failed.
-/// Throws (model_error, input_error) only for a spec that cannot be set up.
-inline run_result simulate(const run_spec& s) {
+/// A run_spec's run_options.
+inline const run_options& options_of(const run_spec& s) { return s; }
+
+/// Output columns for a robot whose q and η entries have these names: t, q_<joint>…,
+/// eta_<name>…, tau_<name>…, r_x, r_y, r_z, rd_x, rd_y, rd_z, err.
+inline std::vector<std::string> run_columns(const std::vector<std::string>& joints, const std::vector<std::string>& eta) {
+  std::vector<std::string> c{"t"};
+  for (const auto& j : joints) c.push_back("q_" + j);
+  for (const auto& e : eta) c.push_back("eta_" + e);
+  for (const auto& e : eta) c.push_back("tau_" + e);
+  for (const char* x : {"r_x", "r_y", "r_z", "rd_x", "rd_y", "rd_z", "err"}) c.emplace_back(x);
+  return c;
+}
+
+/// One closed-loop run on any constrained plant (see the file comment), with x = (q, η):
+///
+/// - `fd`: the plant's nh_forward_dynamics (any model, constraint c);
+/// - `task(q)`: the plant's true task point r(q) (what is measured, before noise);
+/// - `controller(q, η, r_measured, reference(t))` → τ (m entries), generic over the scalar;
+/// - `reference(t)` → task_reference (r_d, ṙ_d, r̈_d).
+///
+/// N, M: the compile-time sizes of q and η (or `dynamic`). `columns`: the output's column
+/// names (3 + n + 2m + 7 of them). Never throws for a failing simulation: the result says why.
+template <int N, int M, class C, class FD, class Task, class Controller, class Reference>
+run_result simulate_closed_loop(const std::string& name, const C& c, const FD& fd, const Task& task,
+                                const Controller& controller, const Reference& reference, const vecN<double, N>& q0,
+                                const vecN<double, M>& eta0, const run_options& s, std::vector<std::string> columns) {
+  constexpr int D = N == dynamic || M == dynamic ? dynamic : N + M;
   const auto t_start = std::chrono::steady_clock::now();
   const double cpu_start = detail::thread_cpu_seconds();
-  const auto plant = presets::paper5<double>(s.plant);
-  const auto nominal = presets::paper5<double>(s.model);
-  const kinematics<double, 5> plant_kin(plant.chain);
-  const auto fd = nh_forward_dynamics(plant.chain, plant.constraint);
-  const rac_controller ctrl(nominal.chain, nominal.constraint, s.gains, s.q0, s.posture_mask);
+  const int n = int(q0.size()), m = int(eta0.size());
   if (!(s.duration > 0) || !(s.output_step > 0) || !(s.sample_rate >= 0) || !(s.noise_sigma >= 0))
-    throw input_error("scene '" + s.name + "': duration and output step must be > 0, sample rate and noise ≥ 0");
+    throw input_error("scene '" + name + "': duration and output step must be > 0, sample rate and noise ≥ 0");
   if (s.noise_sigma > 0 && s.sample_rate == 0)
-    throw input_error("scene '" + s.name + "': measurement noise needs a sampled controller (sampling.rate_hz)");
+    throw input_error("scene '" + name + "': measurement noise needs a sampled controller (sampling.rate_hz)");
+  if (c.dof() != n || c.m() != m)
+    throw input_error("scene '" + name + "': the initial state has " + std::to_string(n) + " + " + std::to_string(m) +
+                      " entries (q, η), the robot " + std::to_string(c.dof()) + " + " + std::to_string(c.m()));
+  if (int(columns.size()) != 1 + n + 2 * m + 7)
+    throw input_error("scene '" + name + "': " + std::to_string(columns.size()) + " column names for " +
+                      std::to_string(1 + n + 2 * m + 7) + " columns");
 
   const long n_out = std::lround(std::floor(s.duration / s.output_step * (1 + 1e-12))) + 1;
   std::vector<double> t_out(static_cast<std::size_t>(n_out));
   for (long i = 0; i < n_out; ++i) t_out[std::size_t(i)] = double(i) * s.output_step;
 
   run_result res;
-  res.name = s.name;
-  res.rows.resize(n_out, Eigen::Index(run_columns().size()));
+  res.name = name;
+  res.columns = std::move(columns);
+  res.rows.resize(n_out, Eigen::Index(res.columns.size()));
   long rows_done = 0;
-  vecN<double, 4> held = vecN<double, 4>::Zero();
+  vecN<double, M> held = vecN<double, M>::Zero(m);
   const bool sampled = s.sample_rate > 0;
 
+  const auto q_of = [n](const auto& x) {
+    using T = typename std::decay_t<decltype(x)>::Scalar;
+    if constexpr (N == dynamic) return vecN<T, N>(x.head(n));
+    else return vecN<T, N>(x.template head<N>());
+  };
+  const auto eta_of = [m](const auto& x) {
+    using T = typename std::decay_t<decltype(x)>::Scalar;
+    if constexpr (M == dynamic) return vecN<T, M>(x.tail(m));
+    else return vecN<T, M>(x.template tail<M>());
+  };
   const auto tau_of = [&](const auto& t, const auto& x, const vec3<std::decay_t<decltype(t)>>& r_meas) {
-    using T = std::decay_t<decltype(t)>;
-    return ctrl(vecN<T, 5>(x.template head<5>()), vecN<T, 4>(x.template tail<4>()), r_meas, s.reference(t));
+    return vecN<std::decay_t<decltype(t)>, M>(controller(q_of(x), eta_of(x), r_meas, reference(t)));
   };
   const auto f = [&](const auto& t, const auto& x) {
     using T = std::decay_t<decltype(t)>;
-    const vecN<T, 5> q = x.template head<5>();
-    const vecN<T, 4> eta = x.template tail<4>();
-    const vecN<T, 4> tau = sampled ? vecN<T, 4>(held.cast<T>()) : tau_of(t, x, plant_kin.point(q, 5));
-    vecN<T, 9> dx;
-    dx << apply_S(plant.constraint, q, eta), fd(q, eta, tau);
+    const vecN<T, N> q = q_of(x);
+    const vecN<T, M> eta = eta_of(x);
+    const vecN<T, M> tau = sampled ? vecN<T, M>(held.template cast<T>()) : tau_of(t, x, vec3<T>(task(q)));
+    vecN<T, D> dx(n + m);
+    dx << apply_S(c, q, eta), fd(q, eta, tau);
     return dx;
   };
-  const auto observe = [&](int i, const vecN<double, 9>& x) {
+  const auto observe = [&](int i, const vecN<double, D>& x) {
     const double t = t_out[std::size_t(i)];
-    const vecN<double, 5> q = x.head<5>();
-    const vec3<double> r = plant_kin.point(q, 5), rd = s.reference(t).r;
-    const vecN<double, 4> tau = sampled ? held : tau_of(t, x, r);
+    const vec3<double> r = task(q_of(x)), rd = reference(t).r;
+    const vecN<double, M> tau = sampled ? held : tau_of(t, x, r);
     auto row = res.rows.row(i);
     row << t, x.transpose(), tau.transpose(), r.transpose(), rd.transpose(), (rd - r).norm();
     res.peak_tau = std::max(res.peak_tau, tau.cwiseAbs().maxCoeff());
     rows_done = i + 1;
   };
 
-  vecN<double, 9> x;
-  x << s.q0, s.eta0;
+  vecN<double, D> x(n + m);
+  x << q0, eta0;
   double dt = 0;
-  std::optional<integration_failure<9>> failure;
+  std::optional<integration_failure<D>> failure;
   if (!sampled) {
-    auto r = integrate<9>(f, x, 0.0, s.duration, s.integrator, t_out, observe, &dt);
+    auto r = integrate<D>(f, x, 0.0, s.duration, s.integrator, t_out, observe, &dt);
     res.steps = r.steps;
     failure = r.failure;
   } else {
@@ -172,13 +228,13 @@ inline run_result simulate(const run_spec& s) {
     for (long k = 0; k < n_samples && !failure; ++k) {
       const double tk = double(k) / s.sample_rate;
       const double tk1 = std::min(double(k + 1) / s.sample_rate, s.duration);
-      vec3<double> r_meas = plant_kin.point(vecN<double, 5>(x.head<5>()), 5);
+      vec3<double> r_meas = task(q_of(x));
       for (int j = 0; j < 3; ++j) r_meas(j) += s.noise_sigma > 0 ? s.noise_sigma * noise() : 0.0;
       try {
         held = tau_of(tk, x, r_meas);
         if (!held.allFinite()) throw numerical_error("the controller's torque is not finite");
       } catch (const std::exception& e) {
-        failure = integration_failure<9>{tk, x, std::string("controller: ") + e.what()};
+        failure = integration_failure<D>{tk, x, std::string("controller: ") + e.what()};
         break;
       }
       res.peak_tau = std::max(res.peak_tau, held.cwiseAbs().maxCoeff());
@@ -191,8 +247,8 @@ inline run_result simulate(const run_spec& s) {
       std::span<const double> piece(t_out.data() + lo, hi - lo);
       integrator_options opts = s.integrator;  // the step budget is the run's, not each piece's
       opts.max_steps = s.integrator.max_steps - res.steps;
-      auto r = integrate<9>(f, x, tk, tk1, opts, piece,
-                            [&](int i, const vecN<double, 9>& xi) { observe(int(lo) + i, xi); }, &dt);
+      auto r = integrate<D>(f, x, tk, tk1, opts, piece,
+                            [&](int i, const vecN<double, D>& xi) { observe(int(lo) + i, xi); }, &dt);
       res.steps += r.steps;
       if (r.failure && r.failure->reason.rfind("too many steps", 0) == 0)
         r.failure->reason = "too many steps (more than " + std::to_string(s.integrator.max_steps) + " in the run)";
@@ -204,11 +260,12 @@ inline run_result simulate(const run_spec& s) {
   if (failure) {
     res.failure = failure->reason + " " + detail::state_text(failure->t, failure->x);
   } else {
+    const Eigen::Index err_col = res.rows.cols() - 1;
     double tail = 0;
     bool any = false;
     for (Eigen::Index i = 0; i < res.rows.rows(); ++i)
       if (res.rows(i, 0) >= s.tail_from - 1e-12) {
-        tail = std::max(tail, res.rows(i, 20));
+        tail = std::max(tail, res.rows(i, err_col));
         any = true;
       }
     res.max_tail_error = any ? tail : NAN;
@@ -226,13 +283,53 @@ inline run_result simulate(const run_spec& s) {
   return res;
 }
 
+/// Runs one paper5 scene (run_spec): the perturbed plant, the robust controller on the
+/// nominal model with r the origin of link 5, by simulate_closed_loop. Never throws for a
+/// failing simulation: the result says why it failed. Throws (model_error, input_error) only
+/// for a spec that cannot be set up.
+inline run_result simulate(const run_spec& s) {
+  if (s.robot != "paper5")
+    throw input_error("scene '" + s.name + "': robot '" + s.robot +
+                      "' is a robot file: simulate_scene (simulation/robot_scene.hpp, needs URDF support) runs it");
+  const auto plant = presets::paper5<double>(s.plant);
+  const auto nominal = presets::paper5<double>(s.model);
+  const kinematics<double, 5> plant_kin(plant.chain);
+  const auto fd = nh_forward_dynamics(plant.chain, plant.constraint);
+  const rac_controller ctrl(nominal.chain, nominal.constraint, s.gains, s.q0, s.posture_mask);
+  const auto task = [&](const auto& q) { return plant_kin.point(q, 5); };
+  return simulate_closed_loop<5, 4>(s.name, plant.constraint, fd, task, ctrl, s.reference, s.q0, s.eta0, options_of(s),
+                                    run_columns());
+}
+
+/// One closed-loop run of any robot (a kinematic tree with its constraint: a robot file's):
+/// the robust task-space controller (controller.hpp) on `nominal` drives the point `point` of
+/// body `body` (1-based, tree_kinematics' numbering; tree::find_frame turns a frame name into
+/// one) of `plant` along `reference`. The posture term holds the joints whose `posture_mask`
+/// entry is 1 at q0. Plant–model mismatch: give `plant` and `nominal` different inertias.
+template <class C, class Reference = circle_reference>
+run_result simulate_robot(const std::string& name, const tree<double>& plant, const tree<double>& nominal, const C& c,
+                          int body, const vec3<double>& point, const Reference& reference, const rac_gains& gains,
+                          const Eigen::VectorXd& q0, const Eigen::VectorXd& eta0, const Eigen::VectorXd& posture_mask,
+                          const run_options& o, const std::vector<std::string>& eta_names) {
+  if (plant.dof() != nominal.dof())
+    throw input_error("scene '" + name + "': plant and model have " + std::to_string(plant.dof()) + " and " +
+                      std::to_string(nominal.dof()) + " joints");
+  const tree_kinematics<double> plant_kin(plant);
+  const auto fd = nh_forward_dynamics(plant, c);
+  const rac_controller ctrl(nominal, c, gains, q0, posture_mask, body, point);
+  const auto task = [&](const auto& q) { return plant_kin.point(q, body, point); };
+  return simulate_closed_loop<dynamic, dynamic>(name, c, fd, task, ctrl, reference, q0, eta0, o,
+                                                run_columns(plant.joint_names(), eta_names));
+}
+
 /// Shortest round-trip decimal form of x (std::to_chars): parsing it gives x back exactly.
 
-/// Writes a run's rows as CSV with a header naming each column (run_columns()).
+/// Writes a run's rows as CSV with a header naming each column (res.columns).
 inline void write_csv(const std::string& path, const run_result& res) {
   std::string text;
-  text.reserve(std::size_t(res.rows.rows() + 1) * 24 * 21);
-  for (std::size_t j = 0; j < run_columns().size(); ++j) text += (j ? "," : "") + run_columns()[j];
+  const auto& cols = res.columns.empty() ? run_columns() : res.columns;
+  text.reserve(std::size_t(res.rows.rows() + 1) * 24 * cols.size());
+  for (std::size_t j = 0; j < cols.size(); ++j) text += (j ? "," : "") + cols[j];
   text += '\n';
   for (Eigen::Index i = 0; i < res.rows.rows(); ++i) {
     for (Eigen::Index j = 0; j < res.rows.cols(); ++j) {
