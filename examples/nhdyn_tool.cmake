@@ -17,6 +17,17 @@ if(TARGET nhdyn::urdf)  # --model x.urdf
   target_link_libraries(nhdyn_tool_objects PUBLIC nhdyn::urdf)
   target_compile_definitions(nhdyn_tool_objects PRIVATE NHDYN_TOOL_URDF=1)
 endif()
+# `mpirun -n N nhdyn simulate …` (Debian's libopenmpi-dev, openmpi-bin): runs spread over
+# processes and machines. Without MPI the tool runs on threads only.
+set(MPI_CXX_SKIP_MPICXX ON)  # the C API from C++; not the deprecated C++ bindings
+find_package(MPI COMPONENTS CXX QUIET)
+if(MPI_CXX_FOUND)
+  target_link_libraries(nhdyn_tool_objects PUBLIC MPI::MPI_CXX)
+  target_compile_definitions(nhdyn_tool_objects PRIVATE NHDYN_TOOL_MPI=1)
+  message(STATUS "nhdyn: MPI found (${MPI_CXX_LIB_NAMES}): nhdyn simulate runs under mpirun")
+else()
+  message(STATUS "nhdyn: MPI not found (libopenmpi-dev): nhdyn simulate uses threads only")
+endif()
 add_executable(nhdyn_tool ${CMAKE_CURRENT_SOURCE_DIR}/nhdyn_tool/main.cpp)
 set_target_properties(nhdyn_tool PROPERTIES OUTPUT_NAME nhdyn RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/${CMAKE_INSTALL_BINDIR})
 target_link_libraries(nhdyn_tool PRIVATE nhdyn_tool_objects nhdyn_project_options)

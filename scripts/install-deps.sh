@@ -9,6 +9,7 @@ pkgs=(
   liburdfdom-dev libtinyxml2-dev
   gnuplot-nox python3 python3-matplotlib
   pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy
+  libopenmpi-dev openmpi-bin
 )
 missing=()
 for p in "${pkgs[@]}"; do

@@ -23,6 +23,21 @@ if(TARGET nhdyn_tool)
               "-DEXPECT_TEXT=mobile-manipulator-circle: 1/1 succeeded"
               "-DEXPECT_HEADER_START=t,q_base_x,q_base_y,q_base_yaw,q_wheel_left_joint," -P ${_sim_check})
   endif()
+  # MPI: a Monte Carlo study on 1 process and under mpirun -n 2, the same runs bit for bit
+  # (not under sanitizers: Open MPI's start-up is not leak-clean).
+  set(MPI_CXX_SKIP_MPICXX ON)
+  find_package(MPI COMPONENTS CXX QUIET)
+  find_package(Python3 COMPONENTS Interpreter QUIET)
+  if(MPI_CXX_FOUND AND MPIEXEC_EXECUTABLE AND Python3_Interpreter_FOUND AND NOT NHDYN_SANITIZE)
+    add_test(NAME simulate_cli_mpi_same_results
+      COMMAND ${CMAKE_COMMAND} -DTOOL=$<TARGET_FILE:nhdyn_tool> -DSCENE=${CMAKE_CURRENT_SOURCE_DIR}/scenes/mpi-monte-carlo.json
+              -DOUT=${CMAKE_CURRENT_BINARY_DIR}/simulate_cli_mpi -DMPIEXEC=${MPIEXEC_EXECUTABLE}
+              -DMPIEXEC_NUMPROC_FLAG=${MPIEXEC_NUMPROC_FLAG} -DPYTHON=${Python3_EXECUTABLE}
+              -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/simulate_mpi_check.cmake)
+    # Open MPI refuses root unless told (CI and the quick start run as root)
+    set_tests_properties(simulate_cli_mpi_same_results PROPERTIES
+      ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1")
+  endif()
   # No NHDYN_SCENES_DIR: the tool finds its shipped scenes from its own location
   # (<build>/bin/nhdyn, <build>/share/nhdyn/scenes), from the test's folder (the build folder).
 endif()

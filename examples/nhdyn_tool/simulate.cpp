@@ -5,7 +5,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <thread>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +20,9 @@
 #include <nhdyn/simulation/scene.hpp>
 #ifdef NHDYN_TOOL_URDF
 #include <nhdyn/simulation/robot_scene.hpp>
+#endif
+#ifdef NHDYN_TOOL_MPI
+#include <mpi.h>
 #endif
 #include <set>
 #include <sstream>
@@ -42,7 +49,10 @@ constexpr std::string_view usage = R"(nhdyn simulate SCENE... --out DIR [--threa
     DIR/<group>-path.png, -error.png, -q.png, -tau.png   figs. 4-6 and tau(t) (gnuplot; one
                         set per scene or study, each run one colour, named in the legend)
   A study's runs go in parallel on --threads workers (default: all cores), with a progress
-  bar and an ETA when stderr is a terminal. Exit status: 0 all runs succeeded, 1 some run failed,
+  bar and an ETA when stderr is a terminal. Under MPI (mpirun -n N nhdyn simulate ...) the
+  runs are handed out one at a time to N processes on any machines (rank 0 runs them too),
+  each process writes the CSVs of its runs, and rank 0 gathers summary.json (each run's
+  "rank" and "host" say where it ran; the results are those of one process, bit for bit). Exit status: 0 all runs succeeded, 1 some run failed,
   2 bad command line.
 )";
 
@@ -171,6 +181,60 @@ std::string fixed(double x, int digits) {
   return os.str();
 }
 
+/// MPI when the tool runs under mpirun (its environment says so), else one process of rank 0.
+struct mpi_session {
+  int rank = 0, size = 1;
+  bool active = false;
+  mpi_session() {
+#ifdef NHDYN_TOOL_MPI
+    if (std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK")) {
+      int provided = 0;
+      MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);  // MPI calls: main thread only
+      active = true;
+      MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+      MPI_Comm_size(MPI_COMM_WORLD, &size);
+    }
+#endif
+  }
+  ~mpi_session() {
+#ifdef NHDYN_TOOL_MPI
+    if (active) MPI_Finalize();
+#endif
+  }
+  mpi_session(const mpi_session&) = delete;
+  mpi_session& operator=(const mpi_session&) = delete;
+};
+
+/// A finished run's summary fields (not its rows: the CSV is written where it ran) as JSON
+/// text, and back: doubles print in their shortest round-trip form, so they travel exactly.
+std::string pack_result(std::size_t i, const nhdyn::run_result& r) {
+  nlohmann::ordered_json e;
+  e["i"] = i;
+  e["name"] = r.name;
+  e["success"] = r.success;
+  e["failure"] = r.failure ? nlohmann::ordered_json(*r.failure) : nullptr;
+  e["max_tail_error"] = std::isfinite(r.max_tail_error) ? nlohmann::ordered_json(r.max_tail_error) : nullptr;
+  e["peak_tau"] = r.peak_tau;
+  e["steps"] = r.steps;
+  e["wall_time_s"] = r.wall_time_s;
+  e["cpu_time_s"] = r.cpu_time_s;
+  e["columns"] = r.columns;
+  return e.dump();
+}
+std::size_t unpack_result(const std::string& text, nhdyn::run_result& r) {
+  const auto e = nlohmann::json::parse(text);
+  r.name = e["name"].get<std::string>();
+  r.success = e["success"].get<bool>();
+  if (!e["failure"].is_null()) r.failure = e["failure"].get<std::string>();
+  r.max_tail_error = e["max_tail_error"].is_null() ? NAN : e["max_tail_error"].get<double>();
+  r.peak_tau = e["peak_tau"].get<double>();
+  r.steps = e["steps"].get<long>();
+  r.wall_time_s = e["wall_time_s"].get<double>();
+  r.cpu_time_s = e["cpu_time_s"].get<double>();
+  r.columns = e["columns"].get<std::vector<std::string>>();
+  return e["i"].get<std::size_t>();
+}
+
 int run(const std::vector<std::string>& args) {
   CLI::App app;
   std::vector<std::string> scenes;
@@ -223,8 +287,9 @@ int run(const std::vector<std::string>& args) {
   }
   std::filesystem::create_directories(dir);
 
-  // Run, writing each CSV as its run finishes.
-  const bool tty = isatty(STDERR_FILENO) != 0;
+  // Run, writing each CSV as its run finishes (in the process that ran it).
+  const mpi_session mpi;
+  const bool tty = mpi.rank == 0 && isatty(STDERR_FILENO) != 0;
   std::mutex m;
   std::size_t done = 0;
   const auto t0 = std::chrono::steady_clock::now();
@@ -233,7 +298,7 @@ int run(const std::vector<std::string>& args) {
 #else
   const auto runner = &nhdyn::simulate;  // paper5 only (robot files need URDF support)
 #endif
-  auto results = nhdyn::run_batch(specs, unsigned(threads), [&](std::size_t i, nhdyn::run_result& r) {
+  const auto finish = [&](nhdyn::run_result& r) {  // in the worker that ran it
     const auto tc = std::chrono::steady_clock::now();
     const double cpu0 = nhdyn::detail::thread_cpu_seconds();
     try {
@@ -245,7 +310,8 @@ int run(const std::vector<std::string>& args) {
     r.wall_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
     r.cpu_time_s += nhdyn::detail::thread_cpu_seconds() - cpu0;
     r.rows.resize(0, 0);  // written; free the memory
-    const std::lock_guard<std::mutex> lock(m);
+  };
+  const auto progress = [&](std::size_t i) {  // rank 0, under m
     ++done;
     if (tty) {
       const int width = 30, filled = int(double(width) * double(done) / double(specs.size()));
@@ -255,13 +321,99 @@ int run(const std::vector<std::string>& args) {
                 << "] " << done << "/" << specs.size() << "  " << fixed(elapsed, 0) << " s, ETA " << fixed(eta, 0) << " s  "
                 << specs[i].name << "\033[K" << std::flush;
     }
-  }, runner);
+  };
+  std::vector<nhdyn::run_result> results;
+  std::vector<int> ranks(specs.size(), 0);
+  if (mpi.size == 1) {
+    results = nhdyn::run_batch(specs, unsigned(threads), [&](std::size_t i, nhdyn::run_result& r) {
+      finish(r);
+      const std::lock_guard<std::mutex> lock(m);
+      progress(i);
+    }, runner);
+  }
+#ifdef NHDYN_TOOL_MPI
+  else {  // runs handed out one at a time by rank 0 (which also runs them), results gathered there
+    const auto run_one = [&](std::size_t i) {
+      nhdyn::run_result r;
+      try {
+        r = runner(specs[i]);
+      } catch (const std::exception& e) {
+        r.name = specs[i].name;
+        r.success = false;
+        r.failure = std::string("setup: ") + e.what();
+      }
+      finish(r);
+      return r;
+    };
+    constexpr int tag_request = 1, tag_index = 2;
+    if (mpi.rank == 0) {
+      results.resize(specs.size());
+      std::atomic<std::size_t> next{0};
+      std::thread local([&] {
+        for (std::size_t i; (i = next.fetch_add(1)) < specs.size();) {
+          nhdyn::run_result r = run_one(i);
+          const std::lock_guard<std::mutex> lock(m);
+          results[i] = std::move(r);
+          progress(i);
+        }
+      });
+      for (int workers = mpi.size - 1; workers > 0;) {
+        int flag = 0;
+        MPI_Status st;
+        MPI_Iprobe(MPI_ANY_SOURCE, tag_request, MPI_COMM_WORLD, &flag, &st);
+        if (!flag) {  // poll gently: a blocking probe would spin on the local worker's core
+          std::this_thread::sleep_for(std::chrono::microseconds(500));
+          continue;
+        }
+        int len = 0;
+        MPI_Get_count(&st, MPI_CHAR, &len);
+        std::string msg(std::size_t(len), '\0');
+        MPI_Recv(msg.data(), len, MPI_CHAR, st.MPI_SOURCE, tag_request, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        if (!msg.empty()) {
+          nhdyn::run_result r;
+          const std::size_t i = unpack_result(msg, r);
+          const std::lock_guard<std::mutex> lock(m);
+          results[i] = std::move(r);
+          ranks[i] = st.MPI_SOURCE;
+          progress(i);
+        }
+        const std::size_t i = next.fetch_add(1);
+        long long index = i < specs.size() ? static_cast<long long>(i) : -1;
+        if (index < 0) --workers;
+        MPI_Send(&index, 1, MPI_LONG_LONG, st.MPI_SOURCE, tag_index, MPI_COMM_WORLD);
+      }
+      local.join();
+    } else {
+      std::string msg;
+      for (;;) {
+        MPI_Send(msg.data(), int(msg.size()), MPI_CHAR, 0, tag_request, MPI_COMM_WORLD);
+        long long index = -1;
+        MPI_Recv(&index, 1, MPI_LONG_LONG, 0, tag_index, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        if (index < 0) break;
+        msg = pack_result(std::size_t(index), run_one(std::size_t(index)));
+      }
+      char host_buf[256] = {};
+      if (gethostname(host_buf, sizeof host_buf - 1) != 0) std::snprintf(host_buf, sizeof host_buf, "unknown");
+      MPI_Send(host_buf, int(std::strlen(host_buf)) + 1, MPI_CHAR, 0, 3, MPI_COMM_WORLD);
+      return 0;  // rank 0 reports
+    }
+  }
+#endif
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (tty) std::cerr << "\r\033[K" << std::flush;
 
   // summary.json and the table.
   char host_buf[256] = {};
   const std::string host = gethostname(host_buf, sizeof host_buf - 1) == 0 ? host_buf : "unknown";
+  std::vector<std::string> hosts(std::size_t(mpi.size), host);
+#ifdef NHDYN_TOOL_MPI
+  if (mpi.size > 1)
+    for (int k = 1; k < mpi.size; ++k) {  // each worker sent its host name after its last run
+      char buf[256] = {};
+      MPI_Recv(buf, 255, MPI_CHAR, k, 3, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      hosts[std::size_t(k)] = buf;
+    }
+#endif
   nlohmann::ordered_json runs = nlohmann::ordered_json::array();
   std::vector<double> tails, peaks;
   int succeeded = 0;
@@ -279,8 +431,8 @@ int run(const std::vector<std::string>& args) {
     e["peak_tau"] = r.peak_tau;
     if (specs[i].run_seed) e["seed"] = *specs[i].run_seed;
     if (!specs[i].factors.empty()) e["factors"] = nlohmann::ordered_json::parse(specs[i].factors);
-    e["rank"] = 0;  // the process that ran it (0: no MPI)
-    e["host"] = host;
+    e["rank"] = ranks[i];  // the process that ran it (0: no MPI)
+    e["host"] = hosts[std::size_t(ranks[i])];
     runs.push_back(e);
     succeeded += r.success;
     cpu_sum += r.cpu_time_s;
@@ -311,7 +463,7 @@ int run(const std::vector<std::string>& args) {
   aggregate["peak_tau"] = percentiles(peaks);
   aggregate["wall_time_s"] = total;
   aggregate["cpu_time_s"] = cpu_sum;
-  aggregate["processes"] = 1;
+  aggregate["processes"] = mpi.size;
   nlohmann::ordered_json summary;
   summary["runs"] = runs;
   summary["aggregate"] = aggregate;
@@ -344,8 +496,10 @@ int run(const std::vector<std::string>& args) {
   double cpu = 0;
   for (const auto& r : results) cpu += r.cpu_time_s;
   std::cout << "total: " << int(results.size()) - failed << "/" << results.size() << " succeeded in "
-            << fixed(total, 2) << " s wall, " << fixed(cpu, 2) << " s cpu (" << (threads ? unsigned(threads) : std::thread::hardware_concurrency())
-            << " threads); files in " << dir.string() << '\n';
+            << fixed(total, 2) << " s wall, " << fixed(cpu, 2) << " s cpu ("
+            << (mpi.size > 1 ? std::to_string(mpi.size) + " MPI processes"
+                             : std::to_string(threads ? unsigned(threads) : std::thread::hardware_concurrency()) + " threads")
+            << "); files in " << dir.string() << '\n';
   if (!no_plots) plot(dir, groups, names, results);
   return failed ? 1 : 0;
 }
