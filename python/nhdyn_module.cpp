@@ -13,8 +13,11 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <nhdyn/analysis/bounds.hpp>
 #include <nhdyn/analysis/linearize.hpp>
 #include <nhdyn/io/json.hpp>
+#include <nhdyn/simulation/batch.hpp>
+#include <nhdyn/simulation/scene.hpp>
 #include <nhdyn/nhdyn.hpp>
 #include <optional>
 #include <string>
@@ -24,6 +27,7 @@
 #if NHDYN_PY_URDF
 #include <nhdyn/io/robot_file.hpp>
 #include <nhdyn/io/urdf.hpp>
+#include <nhdyn/simulation/robot_scene.hpp>
 #endif
 
 namespace py = pybind11;
@@ -377,6 +381,113 @@ batch_function holonomic_state_derivative_of(const Model& mdl) {
           }};
 }
 
+/// Interval boxes from (lo, hi) arrays.
+nhdyn::box<nhdyn::dynamic> box_of(const double* lo, const double* hi, int n) {
+  nhdyn::box<nhdyn::dynamic> b(n);
+  for (int i = 0; i < n; ++i) b(i) = nhdyn::interval(lo[i], hi[i]);  // checked by torque_bounds
+  return b;
+}
+void store_box(const nhdyn::vecN<nhdyn::interval, nhdyn::dynamic>& r, double* lo, double* hi) {
+  for (Eigen::Index i = 0; i < r.size(); ++i) lo[i] = r(i).lower(), hi[i] = r(i).upper();
+}
+template <class Model, class C>
+batch_function nh_bounds_of(const Model& mdl, const C& c, int split) {
+  const int n = mdl.dof(), m = c.m();
+  return {"torque_bounds",
+          {{"q_lo", n}, {"q_hi", n}, {"eta_lo", m}, {"eta_hi", m}, {"eta_dot_lo", m}, {"eta_dot_hi", m}},
+          {{"tau_lo", m}, {"tau_hi", m}},
+          [mdl, c, n, m, split](const auto& in, const auto& out) {
+            const auto r = nhdyn::torque_bounds<nhdyn::dynamic>(mdl, c, box_of(in[0], in[1], n), box_of(in[2], in[3], m),
+                                                                box_of(in[4], in[5], m), split);
+            store_box(r, out[0], out[1]);
+          }};
+}
+template <class Model>
+batch_function holonomic_bounds_of(const Model& mdl, int split) {
+  const int n = mdl.dof();
+  return {"torque_bounds",
+          {{"q_lo", n}, {"q_hi", n}, {"qd_lo", n}, {"qd_hi", n}, {"qdd_lo", n}, {"qdd_hi", n}},
+          {{"tau_lo", n}, {"tau_hi", n}},
+          [mdl, n, split](const auto& in, const auto& out) {
+            const auto r = nhdyn::torque_bounds<nhdyn::dynamic>(mdl, box_of(in[0], in[1], n), box_of(in[2], in[3], n),
+                                                                box_of(in[4], in[5], n), split);
+            store_box(r, out[0], out[1]);
+          }};
+}
+
+/// Where a scene given to nhdyn.simulate names other scenes and robots: the shipped scenes
+/// beside this module (build tree: build/python → build/share/nhdyn/scenes; installed:
+/// lib/python3.X/dist-packages → share/nhdyn/scenes), after $NHDYN_SCENES_DIR.
+nhdyn::scene::search_path scene_dirs(const std::string& module_file) {
+  namespace fs = std::filesystem;
+  nhdyn::scene::search_path dirs;
+  if (const char* e = std::getenv("NHDYN_SCENES_DIR"); e && *e) dirs.emplace_back(e);
+  const fs::path here = fs::path(module_file).parent_path();
+  std::error_code ec;
+  for (const fs::path& d : {here.parent_path() / "share" / "nhdyn" / "scenes",
+                            here.parent_path().parent_path().parent_path() / "share" / "nhdyn" / "scenes"})
+    if (fs::is_directory(d, ec)) dirs.push_back(d);
+  return dirs;
+}
+
+/// A run's result as a dict of NumPy arrays (see nhdyn.simulate's docstring).
+py::dict result_dict(const nhdyn::run_spec& spec, nhdyn::run_result& r) {
+  py::dict d;
+  d["name"] = r.name;
+  d["success"] = r.success;
+  d["failure"] = r.failure ? py::object(py::str(*r.failure)) : py::object(py::none());
+  d["max_tail_error"] = r.max_tail_error;
+  d["peak_tau"] = r.peak_tau;
+  d["steps"] = r.steps;
+  d["cpu_time_s"] = r.cpu_time_s;
+  d["seed"] = spec.run_seed ? py::object(py::int_(*spec.run_seed)) : py::object(py::none());
+  d["columns"] = r.columns;
+  const auto rows = r.rows.rows(), cols = r.rows.cols();
+  py::array_t<double> data({py::ssize_t(rows), py::ssize_t(cols)});
+  std::copy(r.rows.data(), r.rows.data() + rows * cols, data.mutable_data());
+  d["data"] = data;
+  // named blocks by the column names: t, q (n), eta (m), tau (m), r, rd (3 each), err
+  const auto block = [&](const std::string& prefix, int first_hint) {
+    int first = -1, count = 0;
+    for (int j = first_hint; j < int(r.columns.size()); ++j)
+      if (r.columns[std::size_t(j)].rfind(prefix, 0) == 0) {
+        if (first < 0) first = j;
+        ++count;
+      } else if (first >= 0) {
+        break;
+      }
+    py::array_t<double> a({py::ssize_t(rows), py::ssize_t(count)});
+    for (Eigen::Index i = 0; i < rows; ++i)
+      for (int j = 0; j < count; ++j) a.mutable_at(i, j) = r.rows(i, first + j);
+    return std::pair{a, first + count};
+  };
+  const bool paper5 = !r.columns.empty() && r.columns[1] == "q1";
+  auto [q, after_q] = block(paper5 ? "q" : "q_", 1);
+  auto [eta, after_eta] = block("eta", after_q);
+  auto [tau, after_tau] = block("tau", after_eta);
+  d["q"] = q;
+  d["eta"] = eta;
+  d["tau"] = tau;
+  const auto col = [&](int j) {
+    py::array_t<double> a{py::ssize_t(rows)};
+    for (Eigen::Index i = 0; i < rows; ++i) a.mutable_at(i) = r.rows(i, j);
+    return a;
+  };
+  const auto three = [&](int j) {
+    py::array_t<double> a({py::ssize_t(rows), py::ssize_t(3)});
+    for (Eigen::Index i = 0; i < rows; ++i)
+      for (int k = 0; k < 3; ++k) a.mutable_at(i, k) = r.rows(i, j + k);
+    return a;
+  };
+  if (rows > 0 || cols > 0) {
+    d["t"] = col(0);
+    d["r"] = three(int(cols) - 7);
+    d["rd"] = three(int(cols) - 4);
+    d["err"] = col(int(cols) - 1);
+  }
+  return d;
+}
+
 batch_function not_constrained(const model& m, const char* what) {
   throw nhdyn::model_error("model '" + m.name + "' has no constraint: " + what + " needs one (use rne)");
 }
@@ -494,4 +605,58 @@ unit qd.)");
 Constrained: eta_dot = M_eta^-1 (S^T E tau - h_eta) (m entries). Holonomic: qdd (n entries),
 by CRBA + LDL^T or ABA (chosen as the C++ forward_dynamics does). Raises NumericalError for
 a singular mass matrix.)");
+  mod.def("torque_bounds",
+          [](const model& m, int split) {
+            if (split < 0 || split > 30) throw nhdyn::input_error("torque_bounds: split must be in 0…30, not " + std::to_string(split));
+            return m.dispatch([split](const auto& x, const auto& c) { return nh_bounds_of(x, c, split); },
+                              [split](const auto& x) { return holonomic_bounds_of(x, split); });
+          },
+          py::arg("model"), py::arg("split") = 0,
+          R"(torque_bounds(model, split=0) -> f(q_lo, q_hi, eta_lo, eta_hi, eta_dot_lo, eta_dot_hi) -> (tau_lo, tau_hi)
+
+Guaranteed bounds (interval arithmetic, outward rounding) on the torques over a box of
+states: every tau(q, eta, eta_dot) with q in [q_lo, q_hi], ... lies in [tau_lo, tau_hi]
+[N, N m]. Constrained models: the nonholonomic tau (m entries); holonomic:
+f(q_lo, q_hi, qd_lo, qd_hi, qdd_lo, qdd_hi) -> rne bounds (n entries). `split` bisects the
+box 2^split times (tighter bounds, 2^split evaluations). Batches: one box per row. Raises
+InputError for lo > hi or NaN, NumericalError for a box too wide to bound.)");
+  mod.def("simulate",
+          [](const py::object& scene, int threads) {
+            const std::string module_file = py::module_::import("nhdyn").attr("__file__").cast<std::string>();
+            auto dirs = scene_dirs(module_file);
+            nhdyn::scene::json j;
+            if (py::isinstance<py::str>(scene) || py::isinstance(scene, py::module_::import("pathlib").attr("PurePath"))) {
+              auto opened = nhdyn::scene::open(py::str(scene).cast<std::string>(), dirs);
+              j = std::move(opened.j);
+              dirs = std::move(opened.dirs);
+            } else {
+              const std::string text = py::module_::import("json").attr("dumps")(scene).cast<std::string>();
+              j = nhdyn::io::parse_strict<nhdyn::input_error>(text, "scene (a dict): ");
+            }
+            const auto specs = nhdyn::scene::expand(j, dirs);
+            std::vector<nhdyn::run_result> results;
+            {
+              py::gil_scoped_release release;
+#if NHDYN_PY_URDF
+              results = nhdyn::run_batch(specs, unsigned(std::max(0, threads)), [](std::size_t, nhdyn::run_result&) {},
+                                         &nhdyn::simulate_scene);
+#else
+              results = nhdyn::run_batch(specs, unsigned(std::max(0, threads)), [](std::size_t, nhdyn::run_result&) {});
+#endif
+            }
+            py::list out;
+            for (std::size_t i = 0; i < results.size(); ++i) out.append(result_dict(specs[i], results[i]));
+            return out;
+          },
+          py::arg("scene"), py::arg("threads") = 0,
+          R"(simulate(scene, threads=0) -> list of dicts, one per run
+
+Runs a scene, study or suite (docs/simulation.md): `scene` is a file path, the name of a
+shipped scene ("paper-circle", "paper", "mobile-manipulator-circle", ...) or a dict in the
+scene format; a study's runs go on `threads` threads (0: all cores) with the GIL released.
+Each run: {"name", "success", "failure" (str or None), "max_tail_error" [m], "peak_tau",
+"steps", "cpu_time_s", "seed" (Monte Carlo runs), "columns" (the CSV's names), "data" (rows x
+columns), and the blocks "t" [s], "q", "eta", "tau", "r", "rd" [m] (rows x 3), "err" [m]}.
+A failing run is reported, not raised; a scene that cannot be read or set up raises
+InputError naming the field.)");
 }

@@ -181,3 +181,57 @@ def test_linearize_equals_central_differences_of_forward_dynamics():
     Bn = np.column_stack([(g(x, tau + h * e) - g(x, tau - h * e)) / (2 * h) for e in np.eye(4)])
     assert np.allclose(A[5:], An, atol=1e-6 * (1 + abs(An).max())) and np.allclose(B[5:], Bn, atol=1e-6 * (1 + abs(Bn).max()))
     assert np.array_equal(B[:5], np.zeros((5, 4)))
+
+
+def test_torque_bounds_enclose_every_sampled_torque_and_tighten_with_splitting():
+    # an independent check of the enclosure: 2000 point evaluations inside the box (a batch)
+    p = nhdyn.load("paper5")
+    rng = np.random.default_rng(5)
+    q, eta, eta_dot = rng.uniform(-1, 1, 5), rng.uniform(-1, 1, 4), rng.uniform(-1, 1, 4)
+    w = 0.02
+    lo, hi = nhdyn.torque_bounds(p)(q - w, q + w, eta - w, eta + w, eta_dot - w, eta_dot + w)
+    lo2, hi2 = nhdyn.torque_bounds(p, split=3)(q - w, q + w, eta - w, eta + w, eta_dot - w, eta_dot + w)
+    k = 2000
+    Q = q + rng.uniform(-w, w, (k, 5))
+    E, ED = eta + rng.uniform(-w, w, (k, 4)), eta_dot + rng.uniform(-w, w, (k, 4))
+    tau = nhdyn.inverse_dynamics(p)(Q, E, ED, threads=2)
+    assert np.all(tau >= lo2) and np.all(tau <= hi2)
+    assert np.all(lo <= lo2) and np.all(hi2 <= hi) and np.any(hi2 - lo2 < hi - lo)
+    # the bounds are not vacuous: measured 1.1-4.4x the sampled spread at split=3 (interval
+    # arithmetic's dependency effect; samples also miss the corners of the true range)
+    assert np.all(hi2 - lo2 < 10 * (tau.max(axis=0) - tau.min(axis=0)))
+    # holonomic models bound rne; batches are one box per row
+    puma = nhdyn.load("puma560")
+    Z = np.zeros((2, 6))
+    blo, bhi = nhdyn.torque_bounds(puma)(Z - 0.1, Z + 0.1, Z, Z, Z, Z)
+    assert blo.shape == (2, 6) and np.all(blo <= bhi)
+    g = nhdyn.rne(puma)(np.zeros(6), np.zeros(6), np.zeros(6))
+    assert np.all(blo[0] <= g) and np.all(g <= bhi[0])
+    with pytest.raises(nhdyn.InputError, match=r"q\[0\]"):
+        nhdyn.torque_bounds(p)(q + w, q - w, eta, eta, eta_dot, eta_dot)
+
+
+def test_simulate_gives_the_tools_rows_bit_for_bit_and_names_the_columns(tmp_path):
+    scene = {"name": "py-circle", "duration": 2, "success": {"tail_from": 1.5, "max_tail_error": 1}}
+    (run,) = nhdyn.simulate(scene)
+    assert run["success"] and run["failure"] is None
+    assert run["data"].shape == (201, 21) and run["q"].shape == (201, 5) and run["tau"].shape == (201, 4)
+    assert run["columns"][:2] == ["t", "q1"] and run["columns"][-1] == "err"
+    assert np.array_equal(run["err"], np.linalg.norm(run["rd"] - run["r"], axis=1))
+    if not TOOL:
+        pytest.skip("NHDYN_TOOL not set (the tool was not built)")
+    path = tmp_path / "py-circle.json"
+    path.write_text(json.dumps(scene))
+    subprocess.run([TOOL, "simulate", str(path), "--out", str(tmp_path / "out"), "--no-plots"], check=True,
+                   capture_output=True)
+    csv = np.loadtxt(tmp_path / "out" / "py-circle.csv", delimiter=",", skiprows=1)
+    assert np.array_equal(csv, run["data"])
+    # a robot file's scene: columns from its names; a study: one dict per run
+    (mm,) = nhdyn.simulate(os.path.join(SOURCE, "examples", "scenes", "mobile-manipulator-circle.json"))
+    assert mm["success"] and mm["q"].shape[1] == 19 and mm["eta"].shape[1] == 18
+    assert mm["columns"][1] == "q_base_x" and "tau_arm_1_joint" in mm["columns"]
+    runs = nhdyn.simulate({"name": "mc", "study": {"base": scene, "monte_carlo": {"runs": 3, "seed": 1},
+                           "factors": [{"path": "/plant/d3_factor", "distribution": {"uniform": [0.95, 1.05]}}]}}, threads=2)
+    assert [r["name"] for r in runs] == ["mc-0", "mc-1", "mc-2"] and all(r["seed"] is not None for r in runs)
+    with pytest.raises(nhdyn.InputError, match="controller.K2"):
+        nhdyn.simulate({"name": "bad", "controller": {"K2": 1}})
