@@ -446,6 +446,7 @@ py::dict result_dict(const nhdyn::run_spec& spec, nhdyn::run_result& r) {
   py::array_t<double> data({py::ssize_t(rows), py::ssize_t(cols)});
   std::copy(r.rows.data(), r.rows.data() + rows * cols, data.mutable_data());
   d["data"] = data;
+  if (r.columns.empty()) return d;  // failed before it started (a setup error): no rows
   // named blocks by the column names: t, q (n), eta (m), tau (m), r, rd (3 each), err
   const auto block = [&](const std::string& prefix, int first_hint) {
     int first = -1, count = 0;
@@ -459,7 +460,7 @@ py::dict result_dict(const nhdyn::run_spec& spec, nhdyn::run_result& r) {
     py::array_t<double> a({py::ssize_t(rows), py::ssize_t(count)});
     for (Eigen::Index i = 0; i < rows; ++i)
       for (int j = 0; j < count; ++j) a.mutable_at(i, j) = r.rows(i, first + j);
-    return std::pair{a, first + count};
+    return std::pair{a, first < 0 ? first_hint : first + count};
   };
   const bool paper5 = !r.columns.empty() && r.columns[1] == "q1";
   auto [q, after_q] = block(paper5 ? "q" : "q_", 1);
@@ -657,6 +658,7 @@ scene format; a study's runs go on `threads` threads (0: all cores) with the GIL
 Each run: {"name", "success", "failure" (str or None), "max_tail_error" [m], "peak_tau",
 "steps", "cpu_time_s", "seed" (Monte Carlo runs), "columns" (the CSV's names), "data" (rows x
 columns), and the blocks "t" [s], "q", "eta", "tau", "r", "rd" [m] (rows x 3), "err" [m]}.
-A failing run is reported, not raised; a scene that cannot be read or set up raises
-InputError naming the field.)");
+A failing run is reported, not raised: "success" False and "failure" the reason (a run that
+cannot be set up — an unknown frame, a wrong initial size — says "setup: ..." and has no
+rows); a scene file that cannot be read or parsed raises InputError naming the field.)");
 }

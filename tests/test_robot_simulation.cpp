@@ -5,6 +5,7 @@
 // tracking), plant–model mismatch by body name, and the scene format's errors.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <filesystem>
 #include <nhdyn/nhdyn.hpp>
 #include <nhdyn/simulation/robot_scene.hpp>
 #include <nhdyn/simulation/scene.hpp>
@@ -113,6 +114,15 @@ TEST_CASE("robot simulation: plant–model mismatch by body name, and the scene'
   CHECK_THROWS_WITH(parse(R"({"name": "x", "robot": "../robots/mobile_manipulator.json", "task": {"frame": "tool_frame"},
                               "plant": {"mass_factor": [1, 2]}})"),
                     Catch::Contains("plant.mass_factor"));
+  CHECK_THROWS_WITH(parse(R"({"name": "x", "robot": "../robots/mobile_manipulator.json", "task": {"frame": "tool_frame"},
+                              "initial": {"q": []}})"),
+                    Catch::Contains("initial.q"));
+  // a study elsewhere whose base names its robot relative to the base's own folder
+  const auto study = scene::json::parse(R"({"name": "far", "study": {"base": ")" + source("examples/scenes/mobile-manipulator-circle.json") +
+                                        R"(", "set": {"duration": 0.5}, "factors": [{"path": "/controller/kN", "levels": [3, 4]}]}})");
+  const auto far = scene::expand(study, {std::filesystem::temp_directory_path()});
+  REQUIRE(far.size() == 2);
+  CHECK(far[0].robot == source("examples/scenes/../robots/mobile_manipulator.json"));
   // simulate (paper5's) refuses a robot file rather than simulating paper5 instead
   auto t = runs_of("examples/scenes/mobile-manipulator-circle.json").front();
   CHECK_THROWS_WITH(simulate(t), Catch::Contains("simulate_scene"));

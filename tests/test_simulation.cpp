@@ -346,4 +346,11 @@ TEST_CASE("scene: Monte Carlo studies draw each run from its own seed, and a run
   CHECK_THROWS_WITH(scene::expand(bad(R"([{"path": "/duration", "distribution": {"uniform": [2, 1]}}])", R"({"runs": 2})"), dirs),
                     Catch::Contains("lo ≤ hi"));
   CHECK_THROWS_WITH(scene::expand(bad(R"([])", R"({"runs": 0})"), dirs), Catch::Contains("monte_carlo.runs"));
+  CHECK_THROWS_WITH(scene::expand(bad(R"([])", R"({"runs": 2, "replay": [5]})"), dirs), Catch::Contains("replay"));
+  // integer and choice draws stay inside their ranges (the top of the unit interval excluded)
+  const auto ints = scene::expand(scene::json::parse(R"({"name": "i", "study": {)" + base + R"(, "monte_carlo": {"runs": 3000},
+      "factors": [{"path": "/noise/seed", "distribution": {"integer": [0, 2]}}]}})"), dirs);
+  std::set<std::uint64_t> seen;
+  for (const auto& s : ints) seen.insert(s.seed);
+  CHECK(seen == std::set<std::uint64_t>{0, 1, 2});
 }

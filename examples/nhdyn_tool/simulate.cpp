@@ -186,14 +186,24 @@ struct mpi_session {
   int rank = 0, size = 1;
   bool active = false;
   mpi_session() {
+    const char* world = std::getenv("OMPI_COMM_WORLD_SIZE");
+    if (!world) world = std::getenv("PMI_SIZE");
 #ifdef NHDYN_TOOL_MPI
-    if (std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK")) {
+    if (world || std::getenv("PMIX_RANK")) {
       int provided = 0;
       MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);  // MPI calls: main thread only
       active = true;
       MPI_Comm_rank(MPI_COMM_WORLD, &rank);
       MPI_Comm_size(MPI_COMM_WORLD, &size);
+      if (provided < MPI_THREAD_FUNNELED) {
+        if (rank == 0) std::cerr << "nhdyn simulate: the MPI library does not support threads (MPI_THREAD_FUNNELED)\n";
+        MPI_Abort(MPI_COMM_WORLD, 1);
+      }
     }
+#else
+    if (world && std::atoi(world) > 1)  // every process would run every run into the same DIR
+      throw nhdyn::input_error("this nhdyn was built without MPI (libopenmpi-dev) but runs under mpirun with " +
+                               std::string(world) + " processes; run it without mpirun, or rebuild with MPI");
 #endif
   }
   ~mpi_session() {
@@ -219,7 +229,7 @@ std::string pack_result(std::size_t i, const nhdyn::run_result& r) {
   e["wall_time_s"] = r.wall_time_s;
   e["cpu_time_s"] = r.cpu_time_s;
   e["columns"] = r.columns;
-  return e.dump();
+  return e.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);  // a non-UTF-8 reason cannot stop it
 }
 std::size_t unpack_result(const std::string& text, nhdyn::run_result& r) {
   const auto e = nlohmann::json::parse(text);
@@ -301,6 +311,7 @@ int run(const std::vector<std::string>& args) {
   const auto finish = [&](nhdyn::run_result& r) {  // in the worker that ran it
     const auto tc = std::chrono::steady_clock::now();
     const double cpu0 = nhdyn::detail::thread_cpu_seconds();
+    if (r.columns.empty()) return;  // it failed before it started (a setup error): no rows, no CSV
     try {
       nhdyn::write_csv((dir / (r.name + ".csv")).string(), r);
     } catch (const std::exception& e) {
@@ -390,7 +401,14 @@ int run(const std::vector<std::string>& args) {
         long long index = -1;
         MPI_Recv(&index, 1, MPI_LONG_LONG, 0, tag_index, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
         if (index < 0) break;
-        msg = pack_result(std::size_t(index), run_one(std::size_t(index)));
+        try {
+          msg = pack_result(std::size_t(index), run_one(std::size_t(index)));
+        } catch (const std::exception& e) {  // never leave rank 0 waiting: report the run as failed
+          nhdyn::run_result r;
+          r.name = specs[std::size_t(index)].name;
+          r.failure = std::string("rank ") + std::to_string(mpi.rank) + ": " + e.what();
+          msg = pack_result(std::size_t(index), r);
+        }
       }
       char host_buf[256] = {};
       if (gethostname(host_buf, sizeof host_buf - 1) != 0) std::snprintf(host_buf, sizeof host_buf, "unknown");
@@ -437,7 +455,7 @@ int run(const std::vector<std::string>& args) {
     succeeded += r.success;
     cpu_sum += r.cpu_time_s;
     if (std::isfinite(r.max_tail_error)) tails.push_back(r.max_tail_error);
-    peaks.push_back(r.peak_tau);
+    if (!r.columns.empty()) peaks.push_back(r.peak_tau);  // runs that started
   }
   const auto percentiles = [](std::vector<double> v) {
     nlohmann::ordered_json p;

@@ -235,3 +235,7 @@ def test_simulate_gives_the_tools_rows_bit_for_bit_and_names_the_columns(tmp_pat
     assert [r["name"] for r in runs] == ["mc-0", "mc-1", "mc-2"] and all(r["seed"] is not None for r in runs)
     with pytest.raises(nhdyn.InputError, match="controller.K2"):
         nhdyn.simulate({"name": "bad", "controller": {"K2": 1}})
+    # a run that cannot be set up is a failed run (no rows), not a crash or an exception
+    robot = os.path.join(SOURCE, "examples", "robots", "mobile_manipulator.json")
+    (bad,) = nhdyn.simulate({"name": "nowhere", "robot": robot, "task": {"frame": "no_such_frame"}})
+    assert not bad["success"] and "no_such_frame" in bad["failure"] and bad["data"].shape == (0, 0)

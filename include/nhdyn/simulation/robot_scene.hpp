@@ -51,6 +51,8 @@ inline tree<double> with_mass_factors(const tree<double>& t, const std::vector<s
 /// set up (unknown frame or joint, wrong sizes, a robot file without a constraint).
 inline run_result simulate_scene(const run_spec& s) {
   if (s.robot == "paper5") return simulate(s);
+  const auto t_start = std::chrono::steady_clock::now();  // the times include loading the robot
+  const double cpu_start = detail::thread_cpu_seconds();
   const std::string where = "scene '" + s.name + "': ";
   const io::robot_model r = io::load_robot_file(s.robot);
   if (!r.constraint)
@@ -80,12 +82,15 @@ inline run_result simulate_scene(const run_spec& s) {
     }
     mask(it - joints.begin()) = 1;
   }
-  return std::visit(
+  run_result out = std::visit(
       [&](const auto& c) {
         return simulate_robot(s.name, plant, nominal, c, f.body + 1, point, s.reference, s.gains, q0, eta0, mask,
                               options_of(s), r.eta_names());
       },
       *r.constraint);
+  out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  out.cpu_time_s = detail::thread_cpu_seconds() - cpu_start;
+  return out;
 }
 
 }  // namespace nhdyn

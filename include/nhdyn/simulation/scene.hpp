@@ -224,7 +224,8 @@ inline run_spec parse_run(const json& j, const std::vector<std::filesystem::path
   } else {  // the sizes are the robot's, checked when it is loaded
     const auto list = [&](const char* k) {
       const json& v = init.j.at(k);
-      if (!v.is_array()) throw input_error(where + "field 'initial." + std::string(k) + "' must be a list of numbers");
+      if (!v.is_array() || v.empty())
+        throw input_error(where + "field 'initial." + std::string(k) + "' must be a non-empty list of numbers");
       return init.vector(k, int(v.size()));
     };
     if (init.has("q")) s.q_start = list("q");
@@ -347,8 +348,9 @@ inline std::string level_text(const json& v) {
   return v.is_string() ? v.get<std::string>() : v.dump();
 }
 
-/// Run k's seed in a Monte Carlo study seeded with `seed`: splitmix64 of seed + k, so that
-/// runs are independent streams and any one is reproduced from its seed alone.
+/// Run k's seed in a Monte Carlo study seeded with `seed`: the (k+1)-th output of splitmix64
+/// started at `seed` (its finaliser of seed + (k+1)·γ), so that runs are independent streams
+/// and any one is reproduced from its seed alone.
 inline std::uint64_t run_seed(std::uint64_t seed, std::uint64_t k) {
   std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (k + 1);
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
@@ -364,14 +366,20 @@ struct distribution {
   double a = 0, b = 1;
   json levels;
   json draw(std::mt19937_64& g) const {
-    const auto unit = [&] { return (double(g() >> 11) + 0.5) * 0x1.0p-53; };  // (0, 1)
-    const auto gauss = [&] { return std::sqrt(-2 * std::log(unit())) * std::cos(2 * 3.14159265358979323846 * unit()); };
+    const auto unit = [&] { return (double(g() >> 11) + 0.5) * 0x1.0p-53; };  // (0, 1]
+    const auto index = [&](std::uint64_t count) {  // 0 … count − 1, uniformly (count ≤ 2^53)
+      return std::min<std::uint64_t>(count - 1, std::uint64_t(double(g() >> 11) * 0x1.0p-53 * double(count)));
+    };
+    const auto gauss = [&] {  // Box–Muller, its two uniforms drawn in a fixed order
+      const double u1 = unit(), u2 = unit();
+      return std::sqrt(-2 * std::log(u1)) * std::cos(2 * 3.14159265358979323846 * u2);
+    };
     switch (kind) {
       case uniform: return a + (b - a) * unit();
       case normal: return a + b * gauss();
       case lognormal: return std::exp(a + b * gauss());
-      case integer: return std::int64_t(a) + std::int64_t(unit() * (b - a + 1));
-      case choice: return levels[std::size_t(unit() * double(levels.size()))];
+      case integer: return std::int64_t(a) + std::int64_t(index(std::uint64_t(b - a) + 1));
+      case choice: return levels[std::size_t(index(levels.size()))];
     }
     return nullptr;
   }
@@ -402,8 +410,9 @@ inline distribution read_distribution(const json& j, const std::string& where) {
     if (!(d.b >= 0)) throw input_error(where + "'" + k + "': the spread must be ≥ 0");
   } else if (k == "integer") {
     d.kind = distribution::integer;
-    if (d.a != std::floor(d.a) || d.b != std::floor(d.b) || !(d.a <= d.b) || std::abs(d.a) > 9e15 || std::abs(d.b) > 9e15)
-      throw input_error(where + "'integer': needs integers lo ≤ hi");
+    if (d.a != std::floor(d.a) || d.b != std::floor(d.b) || !(d.a <= d.b) || d.b - d.a >= 0x1.0p53 ||
+        std::abs(d.a) > 0x1.0p53 || std::abs(d.b) > 0x1.0p53)
+      throw input_error(where + "'integer': needs integers lo ≤ hi, |lo|, |hi| and hi − lo below 2^53");
   } else {
     throw input_error(where + "unknown distribution '" + k + "' (known: uniform, normal, lognormal, integer, choice)");
   }
@@ -447,7 +456,13 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth, co
     const object o(resolved, where, "", {"name", "description", "study"});
     const object st = o.sub("study", {"base", "set", "factors", "monte_carlo"});
     if (!st.has("base")) throw input_error(where + "field 'study.base' is required");
-    json base = st.j["base"].is_string() ? load(st.j["base"].get<std::string>(), dirs) : st.j["base"];
+    json base = st.j["base"];
+    search_path base_dirs = dirs;  // a robot file named in the base resolves from the base's folder
+    if (st.j["base"].is_string()) {
+      auto opened = open_nested(st.j["base"].get<std::string>(), dirs);
+      base = std::move(opened.j);
+      base_dirs = std::move(opened.dirs);
+    }
     if (!base.is_object() || base.contains("study") || base.contains("scenes"))
       throw input_error(where + "field 'study.base' must be a single scene");
     if (st.has("set")) {
@@ -502,6 +517,8 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth, co
           throw input_error(where + "field '" + field + "' must be a non-negative integer");
         return v.get<std::uint64_t>();
       };
+      if (mc.has("replay") && (mc.has("runs") || mc.has("seed")))
+        throw input_error(where + "field 'study.monte_carlo': 'replay' lists the seeds to run, without 'runs' or 'seed'");
       if (mc.has("replay")) {  // the runs of these seeds only (a run replayed alone)
         if (!mc.j["replay"].is_array() || mc.j["replay"].empty())
           throw input_error(where + "field 'study.monte_carlo.replay' must be a non-empty list of run seeds");
@@ -526,7 +543,7 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth, co
         std::string idx = std::to_string(k);
         idx.insert(0, std::size_t(width) - std::min(idx.size(), std::size_t(width)), '0');
         run["name"] = name + (mc.has("replay") ? "-seed_" + std::to_string(seeds[k]) : "-" + idx);
-        out.push_back(parse_run(run, dirs));
+        out.push_back(parse_run(run, base_dirs));
         out.back().run_seed = seeds[k];
         out.back().factors = drawn.dump();
       }
@@ -551,7 +568,7 @@ inline void expand_into(const json& j, std::vector<run_spec>& out, int depth, co
         run_name += level_text(v);
       }
       run["name"] = run_name;
-      out.push_back(parse_run(run, dirs));
+      out.push_back(parse_run(run, base_dirs));
       out.back().factors = levels.dump();
       more = false;
       for (std::size_t i = factors.size(); i-- > 0;) {

@@ -150,7 +150,7 @@ inline std::vector<std::string> run_columns(const std::vector<std::string>& join
 /// - `reference(t)` → task_reference (r_d, ṙ_d, r̈_d).
 ///
 /// N, M: the compile-time sizes of q and η (or `dynamic`). `columns`: the output's column
-/// names (3 + n + 2m + 7 of them). Never throws for a failing simulation: the result says why.
+/// names (1 + n + 2m + 7 of them). The result's times cover the integration and the output. Never throws for a failing simulation: the result says why.
 template <int N, int M, class C, class FD, class Task, class Controller, class Reference>
 run_result simulate_closed_loop(const std::string& name, const C& c, const FD& fd, const Task& task,
                                 const Controller& controller, const Reference& reference, const vecN<double, N>& q0,
@@ -182,12 +182,12 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
   vecN<double, M> held = vecN<double, M>::Zero(m);
   const bool sampled = s.sample_rate > 0;
 
-  const auto q_of = [n](const auto& x) {
+  const auto q_of = [&](const auto& x) {
     using T = typename std::decay_t<decltype(x)>::Scalar;
     if constexpr (N == dynamic) return vecN<T, N>(x.head(n));
     else return vecN<T, N>(x.template head<N>());
   };
-  const auto eta_of = [m](const auto& x) {
+  const auto eta_of = [&](const auto& x) {
     using T = typename std::decay_t<decltype(x)>::Scalar;
     if constexpr (M == dynamic) return vecN<T, M>(x.tail(m));
     else return vecN<T, M>(x.template tail<M>());
@@ -288,6 +288,8 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
 /// failing simulation: the result says why it failed. Throws (model_error, input_error) only
 /// for a spec that cannot be set up.
 inline run_result simulate(const run_spec& s) {
+  const auto t_start = std::chrono::steady_clock::now();  // the times include the set-up
+  const double cpu_start = detail::thread_cpu_seconds();
   if (s.robot != "paper5")
     throw input_error("scene '" + s.name + "': robot '" + s.robot +
                       "' is a robot file: simulate_scene (simulation/robot_scene.hpp, needs URDF support) runs it");
@@ -297,8 +299,11 @@ inline run_result simulate(const run_spec& s) {
   const auto fd = nh_forward_dynamics(plant.chain, plant.constraint);
   const rac_controller ctrl(nominal.chain, nominal.constraint, s.gains, s.q0, s.posture_mask);
   const auto task = [&](const auto& q) { return plant_kin.point(q, 5); };
-  return simulate_closed_loop<5, 4>(s.name, plant.constraint, fd, task, ctrl, s.reference, s.q0, s.eta0, options_of(s),
-                                    run_columns());
+  run_result r = simulate_closed_loop<5, 4>(s.name, plant.constraint, fd, task, ctrl, s.reference, s.q0, s.eta0,
+                                            options_of(s), run_columns());
+  r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  r.cpu_time_s = detail::thread_cpu_seconds() - cpu_start;
+  return r;
 }
 
 /// One closed-loop run of any robot (a kinematic tree with its constraint: a robot file's):
