@@ -640,7 +640,7 @@ InputError for lo > hi or NaN, NumericalError for a box too wide to bound.)");
               py::gil_scoped_release release;
 #if NHDYN_PY_URDF
               results = nhdyn::run_batch(specs, unsigned(std::max(0, threads)), [](std::size_t, nhdyn::run_result&) {},
-                                         &nhdyn::simulate_scene);
+                                         nhdyn::simulate_scene);
 #else
               results = nhdyn::run_batch(specs, unsigned(std::max(0, threads)), [](std::size_t, nhdyn::run_result&) {});
 #endif

@@ -304,9 +304,9 @@ int run(const std::vector<std::string>& args) {
   std::size_t done = 0;
   const auto t0 = std::chrono::steady_clock::now();
 #ifdef NHDYN_TOOL_URDF
-  const auto runner = &nhdyn::simulate_scene;  // paper5 and robot files
+  const auto runner = nhdyn::simulate_scene;  // paper5 and robot files
 #else
-  const auto runner = &nhdyn::simulate;  // paper5 only (robot files need URDF support)
+  const auto runner = nhdyn::simulate;  // paper5 only (robot files need URDF support)
 #endif
   const auto finish = [&](nhdyn::run_result& r) {  // in the worker that ran it
     const auto tc = std::chrono::steady_clock::now();

@@ -23,9 +23,9 @@ namespace nhdyn {
 /// spec that cannot be set up (bad model) becomes a failed run with the error as reason.
 /// `run(spec)` simulates one spec: `simulate` (paper5, the default) or `simulate_scene`
 /// (any robot, simulation/robot_scene.hpp).
-template <class OnDone, class Run = run_result (*)(const run_spec&)>
+template <class OnDone, class Run = simulate_fn>
 std::vector<run_result> run_batch(const std::vector<run_spec>& specs, unsigned threads, OnDone&& on_done,
-                                  Run run = &simulate) {
+                                  Run run = {}) {
   std::vector<run_result> results(specs.size());
   std::atomic<std::size_t> next{0};
   const auto worker = [&] {

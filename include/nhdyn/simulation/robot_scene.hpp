@@ -13,6 +13,7 @@
 /// mass factors by body name (each scales the body's mass and rotational inertia, so its
 /// centre of mass stays where it is).
 #include <algorithm>
+#include <concepts>
 #include <string>
 #include <variant>
 
@@ -48,49 +49,52 @@ inline tree<double> with_mass_factors(const tree<double>& t, const std::vector<s
 }
 
 /// One run of a scene on its robot (see the file comment). Throws for a scene that cannot be
-/// set up (unknown frame or joint, wrong sizes, a robot file without a constraint).
-inline run_result simulate_scene(const run_spec& s) {
-  if (s.robot == "paper5") return simulate(s);
-  const auto t_start = std::chrono::steady_clock::now();  // the times include loading the robot
-  const double cpu_start = detail::thread_cpu_seconds();
-  const std::string where = "scene '" + s.name + "': ";
-  const io::robot_model r = io::load_robot_file(s.robot);
-  if (!r.constraint)
-    throw input_error(where + "robot file '" + s.robot +
-                      "' has no constraint: the task-space controller drives a wheeled robot (give the file a \"constraint\")");
-  const tree<double> plant = with_mass_factors(r.model, s.plant_mass, where + "plant: ");
-  const tree<double> nominal = with_mass_factors(r.model, s.model_mass, where + "model: ");
-  const int n = r.model.dof(), m = n - r.k();
-  const auto f = r.model.find_frame(s.task_frame);  // throws naming the frame and the known ones
-  const vec3<double> point = f.R * s.task_point + f.p;
-  const auto sized = [&](const Eigen::VectorXd& v, int size, const char* what) {
-    if (v.size() == 0) return Eigen::VectorXd(Eigen::VectorXd::Zero(size));
-    if (v.size() != size)
-      throw input_error(where + "field 'initial." + what + "' has " + std::to_string(v.size()) + " entries, robot '" +
-                        r.name + "' needs " + std::to_string(size));
-    return v;
-  };
-  const Eigen::VectorXd q0 = sized(s.q_start, n, "q"), eta0 = sized(s.eta_start, m, "eta");
-  Eigen::VectorXd mask = Eigen::VectorXd::Zero(n);
-  const auto joints = r.model.joint_names();
-  for (const auto& j : s.posture_joints) {
-    const auto it = std::find(joints.begin(), joints.end(), j);
-    if (it == joints.end()) {
-      std::string known;
-      for (const auto& k : joints) known += (known.empty() ? "" : ", ") + k;
-      throw input_error(where + "field 'controller.posture_joints': no joint '" + j + "' (joints: " + known + ")");
-    }
-    mask(it - joints.begin()) = 1;
+/// set up (unknown frame or joint, wrong sizes, a robot file without a constraint). A function
+/// object, as `simulate`: the closed loops (one per constraint type) are compiled only where
+/// it is called.
+struct simulate_scene_fn {
+  template <std::same_as<run_spec> Spec>
+  run_result operator()(const Spec& s) const {
+    if (s.robot == "paper5") return simulate(s);
+    return detail::timed([&] {  // the times include loading the robot
+      const std::string where = "scene '" + s.name + "': ";
+      const io::robot_model r = io::load_robot_file(s.robot);
+      if (!r.constraint)
+        throw input_error(where + "robot file '" + s.robot +
+                          "' has no constraint: the task-space controller drives a wheeled robot (give the file a \"constraint\")");
+      const tree<double> plant = with_mass_factors(r.model, s.plant_mass, where + "plant: ");
+      const tree<double> nominal = with_mass_factors(r.model, s.model_mass, where + "model: ");
+      const int n = r.model.dof(), m = n - r.k();
+      const auto f = r.model.find_frame(s.task_frame);  // throws naming the frame and the known ones
+      const vec3<double> point = f.R * s.task_point + f.p;
+      const auto sized = [&](const Eigen::VectorXd& v, int size, const char* what) {
+        if (v.size() == 0) return Eigen::VectorXd(Eigen::VectorXd::Zero(size));
+        if (v.size() != size)
+          throw input_error(where + "field 'initial." + what + "' has " + std::to_string(v.size()) + " entries, robot '" +
+                            r.name + "' needs " + std::to_string(size));
+        return v;
+      };
+      const Eigen::VectorXd q0 = sized(s.q_start, n, "q"), eta0 = sized(s.eta_start, m, "eta");
+      Eigen::VectorXd mask = Eigen::VectorXd::Zero(n);
+      const auto joints = r.model.joint_names();
+      for (const auto& j : s.posture_joints) {
+        const auto it = std::find(joints.begin(), joints.end(), j);
+        if (it == joints.end()) {
+          std::string known;
+          for (const auto& k : joints) known += (known.empty() ? "" : ", ") + k;
+          throw input_error(where + "field 'controller.posture_joints': no joint '" + j + "' (joints: " + known + ")");
+        }
+        mask(it - joints.begin()) = 1;
+      }
+      return std::visit(
+          [&](const auto& c) {
+            return simulate_robot(s.name, plant, nominal, c, f.body + 1, point, s.reference, s.gains, q0, eta0, mask,
+                                  options_of(s), r.eta_names());
+          },
+          *r.constraint);
+    });
   }
-  run_result out = std::visit(
-      [&](const auto& c) {
-        return simulate_robot(s.name, plant, nominal, c, f.body + 1, point, s.reference, s.gains, q0, eta0, mask,
-                              options_of(s), r.eta_names());
-      },
-      *r.constraint);
-  out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  out.cpu_time_s = detail::thread_cpu_seconds() - cpu_start;
-  return out;
-}
+};
+inline constexpr simulate_scene_fn simulate_scene{};
 
 }  // namespace nhdyn

@@ -17,6 +17,7 @@
 ///     nhdyn::run_result res = nhdyn::simulate(spec);
 ///     nhdyn::write_csv("paper-circle.csv", res);
 #include <charconv>
+#include <concepts>
 #include <chrono>
 #include <cstdint>
 #include <ctime>
@@ -204,7 +205,11 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
     dx << apply_S(c, q, eta), fd(q, eta, tau);
     return dx;
   };
-  const auto observe = [&](int i, const vecN<double, D>& x) {
+  // Output k of the integration piece under way is row row0 + k (continuous: one piece, row0 = 0).
+  // One observer type for both modes, so that the integrators are instantiated once.
+  long row0 = 0;
+  const auto observe = [&](int k, const vecN<double, D>& x) {
+    const long i = row0 + k;
     const double t = t_out[std::size_t(i)];
     const vec3<double> r = task(q_of(x)), rd = reference(t).r;
     const vecN<double, M> tau = sampled ? held : tau_of(t, x, r);
@@ -247,8 +252,8 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
       std::span<const double> piece(t_out.data() + lo, hi - lo);
       integrator_options opts = s.integrator;  // the step budget is the run's, not each piece's
       opts.max_steps = s.integrator.max_steps - res.steps;
-      auto r = integrate<D>(f, x, tk, tk1, opts, piece,
-                            [&](int i, const vecN<double, D>& xi) { observe(int(lo) + i, xi); }, &dt);
+      row0 = long(lo);
+      auto r = integrate<D>(f, x, tk, tk1, opts, piece, observe, &dt);
       res.steps += r.steps;
       if (r.failure && r.failure->reason.rfind("too many steps", 0) == 0)
         r.failure->reason = "too many steps (more than " + std::to_string(s.integrator.max_steps) + " in the run)";
@@ -283,28 +288,44 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
   return res;
 }
 
+namespace detail {
+/// f()'s run_result with its wall and CPU times those of the whole call (set-up included).
+template <class F>
+run_result timed(const F& f) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const double cpu_start = thread_cpu_seconds();
+  run_result r = f();
+  r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  r.cpu_time_s = thread_cpu_seconds() - cpu_start;
+  return r;
+}
+}  // namespace detail
+
 /// Runs one paper5 scene (run_spec): the perturbed plant, the robust controller on the
 /// nominal model with r the origin of link 5, by simulate_closed_loop. Never throws for a
 /// failing simulation: the result says why it failed. Throws (model_error, input_error) only
-/// for a spec that cannot be set up.
-inline run_result simulate(const run_spec& s) {
-  const auto t_start = std::chrono::steady_clock::now();  // the times include the set-up
-  const double cpu_start = detail::thread_cpu_seconds();
-  if (s.robot != "paper5")
-    throw input_error("scene '" + s.name + "': robot '" + s.robot +
-                      "' is a robot file: simulate_scene (simulation/robot_scene.hpp, needs URDF support) runs it");
-  const auto plant = presets::paper5<double>(s.plant);
-  const auto nominal = presets::paper5<double>(s.model);
-  const kinematics<double, 5> plant_kin(plant.chain);
-  const auto fd = nh_forward_dynamics(plant.chain, plant.constraint);
-  const rac_controller ctrl(nominal.chain, nominal.constraint, s.gains, s.q0, s.posture_mask);
-  const auto task = [&](const auto& q) { return plant_kin.point(q, 5); };
-  run_result r = simulate_closed_loop<5, 4>(s.name, plant.constraint, fd, task, ctrl, s.reference, s.q0, s.eta0,
-                                            options_of(s), run_columns());
-  r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  r.cpu_time_s = detail::thread_cpu_seconds() - cpu_start;
-  return r;
-}
+/// for a spec that cannot be set up. A function object, `simulate(spec)`, whose call is a
+/// template: the closed loop (with its dual-number Jacobian for rosenbrock4) is compiled only
+/// where it is called, not by every file that includes this header.
+struct simulate_fn {
+  template <std::same_as<run_spec> Spec>
+  run_result operator()(const Spec& s) const {
+    return detail::timed([&] {
+      if (s.robot != "paper5")
+        throw input_error("scene '" + s.name + "': robot '" + s.robot +
+                          "' is a robot file: simulate_scene (simulation/robot_scene.hpp, needs URDF support) runs it");
+      const auto plant = presets::paper5<double>(s.plant);
+      const auto nominal = presets::paper5<double>(s.model);
+      const kinematics<double, 5> plant_kin(plant.chain);
+      const auto fd = nh_forward_dynamics(plant.chain, plant.constraint);
+      const rac_controller ctrl(nominal.chain, nominal.constraint, s.gains, s.q0, s.posture_mask);
+      const auto task = [&](const auto& q) { return plant_kin.point(q, 5); };
+      return simulate_closed_loop<5, 4>(s.name, plant.constraint, fd, task, ctrl, s.reference, s.q0, s.eta0,
+                                        options_of(s), run_columns());
+    });
+  }
+};
+inline constexpr simulate_fn simulate{};
 
 /// One closed-loop run of any robot (a kinematic tree with its constraint: a robot file's):
 /// the robust task-space controller (controller.hpp) on `nominal` drives the point `point` of
