@@ -215,7 +215,7 @@ TEST_CASE("scene: the shipped studies expand to paper5.md's designs") {
     CHECK(noise[i].plant.d3_factor == 1.0);
   }
   const auto circle = runs_of("paper-circle")[0];
-  CHECK(circle.reference.omega == 2 * 3.14159265358979323846 / 20);
+  CHECK(std::get<circle_reference>(circle.reference).omega == 2 * 3.14159265358979323846 / 20);
   CHECK(circle.q0(2) == 3.141592653589793);
   CHECK(circle.gains.K0(1, 1) == 400);
   CHECK(circle.gains.lambda == 0.02);

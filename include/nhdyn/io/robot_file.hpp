@@ -44,6 +44,11 @@ struct robot_model {
   tree<double> model;
   std::optional<robot_constraint> constraint;
   std::string name;
+  /// Where the constraint came from (the file's "constraint" object, its path, whether the
+  /// base is planar): constraint_on reads it again on another tree.
+  json constraint_source{};
+  std::string path{};
+  bool planar_base = false;
 
   /// Names of η's entries: the constraint's (`eta_names` of its type), or the joint names.
   std::vector<std::string> eta_names() const {
@@ -241,7 +246,22 @@ inline robot_model parse_robot_file(const std::string& text, const std::string& 
   out.name = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : out.model.name();
   if (j.contains("drives")) out.model = detail::with_drives(out.model, j["drives"], top);
   if (j.contains("constraint")) out.constraint = detail::read_robot_constraint(j["constraint"], out.model, top, opt);
+  if (j.contains("constraint")) out.constraint_source = j["constraint"];
+  out.path = path;
+  out.planar_base = opt.planar_base;
   return out;
+}
+
+/// r's constraint read again on the tree t (r's joints, other placements: a plant whose link
+/// lengths differ from the file's), so that the geometry a constraint takes from the URDF
+/// (the wheels' positions) follows t. Warnings were given when r was loaded: none again.
+/// Empty when r has no constraint.
+inline std::optional<robot_constraint> constraint_on(const robot_model& r, const tree<double>& t) {
+  if (r.constraint_source.is_null()) return r.constraint;
+  urdf_options opt;
+  opt.planar_base = r.planar_base;
+  opt.warn = [](const std::string&) {};
+  return detail::read_robot_constraint(r.constraint_source, t, detail::place{"robot file '" + r.path + "'"}, opt);
 }
 
 /// The robot file at `path`.

@@ -25,6 +25,8 @@
 ///     Eigen::Vector4d tau = ctrl(q, eta, r_measured, circle(t));
 ///     // any tree and constraint, the point p on body i (1-based, as tree_kinematics):
 ///     nhdyn::rac_controller arm(tree, c, gains, q0, mask, i, p);
+#include <variant>
+
 #include <Eigen/Dense>
 
 #include "../constraints/stages.hpp"
@@ -32,34 +34,9 @@
 #include "../dynamics/tree.hpp"
 #include "../kinematics/kinematics.hpp"
 #include "../kinematics/tree.hpp"
+#include "references.hpp"
 
 namespace nhdyn {
-
-/// r_d(t) and its first two derivatives.
-template <class T>
-struct task_reference {
-  vec3<T> r, rd, rdd;
-};
-
-/// r_d(t) = c + R (u cos(ω t + φ) + v sin(ω t + φ)): paper5's circle is c = (0.35, 0, 0),
-/// R = 1, u = y₀, v = z₀, ω = 2π/20, φ = 0.
-struct circle_reference {
-  Eigen::Vector3d center{0.35, 0, 0}, u{0, 1, 0}, v{0, 0, 1};
-  double radius = 1, omega = 2 * 3.14159265358979323846 / 20, phase = 0;
-
-  template <class T>
-  task_reference<T> operator()(const T& t) const {
-    using std::cos;
-    using std::sin;
-    const T th = T(omega) * t + T(phase), c = cos(th), s = sin(th);
-    const vec3<T> U = u.cast<T>(), V = v.cast<T>();
-    task_reference<T> ref;
-    ref.r = center.cast<T>() + T(radius) * (c * U + s * V);
-    ref.rd = T(radius * omega) * (c * V - s * U);
-    ref.rdd = T(-radius * omega * omega) * (c * U + s * V);
-    return ref;
-  }
-};
 
 /// The robust term's constants (Table III) and the boundary layer ε (0: none).
 struct robust_gains {
@@ -207,5 +184,90 @@ template <class S, int N, class C, class... A>
 rac_controller(const chain<S, N>&, C, A...) -> rac_controller<S, N, C>;
 template <class S, class C, class... A>
 rac_controller(const tree<S>&, C, A...) -> rac_controller<S, dynamic, C, tree<S>>;
+
+/// Gains of the joint-space computed-torque controller (defaults: ω_n = 10 rad/s, ζ = 1).
+struct ct_gains {
+  double kp = 100;  ///< k_P [1/s²]
+  double kd = 20;   ///< k_D [1/s]
+};
+
+/// The joint-space computed-torque controller (Siciliano et al., Robotics, §8.5.2) for any
+/// model and constraint, on its nominal model and a joint-space reference (q_d, q̇_d, q̈_d):
+///
+///     q̇ = S η,   a_q = q̈_d + k_D (q̇_d − q̇) + k_P (q_d − q)
+///     η̇* = (SᵀS)⁻¹ Sᵀ (a_q − Ṡ η)        (the admissible η̇ nearest to a_q, least squares)
+///     τ  = (SᵀS)⁻¹ Sᵀ rne_nominal(q, Sη, Sη̇* + Ṡη)                      (eq. 21)
+///
+/// Without a constraint (S = I) this is τ = M(q) a_q + h(q, q̇), and on the nominal plant the
+/// error obeys ë + k_D ė + k_P e = 0. With a constraint only the part of the error that the
+/// admissible motions can correct is corrected: a nonholonomic base's sideways error is not
+/// (no smooth static feedback stabilises it, Brockett 1983) — drive a wheeled base with the
+/// task-space controller, or give it a feasible joint-space path and a small initial error.
+template <class S, int N, class C, class Model = chain<S, N>>
+class computed_torque_controller {
+ public:
+  static constexpr int M = C::m_at_compile_time;
+
+  computed_torque_controller(const Model& nominal, C c, ct_gains g)
+      : c_(c), id_(inverse_dynamics(nominal, c)), g_(g), n_(nominal.dof()) {
+    if (!(g_.kp >= 0) || !(g_.kd >= 0) || !std::isfinite(g_.kp) || !std::isfinite(g_.kd))
+      throw input_error("computed-torque controller: need finite k_P, k_D ≥ 0");
+    if (c_.dof() != n_)
+      throw input_error("computed-torque controller: the constraint is for " + std::to_string(c_.dof()) +
+                        " coordinates, the model has " + std::to_string(n_));
+  }
+  const ct_gains& gains() const { return g_; }
+
+  /// τ (m entries) for the state (q, η) and a joint-space reference (ref.q, ref.qd, ref.qdd);
+  /// the measured task point is not used.
+  template <class T>
+  vecN<T, M> operator()(const vecN<T, N>& q, const vecN<T, M>& eta, const vec3<T>&, const task_reference<T>& ref) const {
+    if (ref.q.size() != n_ || ref.qd.size() != n_ || ref.qdd.size() != n_)
+      throw input_error("computed-torque controller: needs a joint-space reference with " + std::to_string(n_) +
+                        " joints (q_d, q̇_d, q̈_d), got " + std::to_string(ref.q.size()));
+    const vecN<T, N> qd = apply_S(c_, q, eta);
+    const vecN<T, N> a = vecN<T, N>(ref.qdd) + T(g_.kd) * (vecN<T, N>(ref.qd) - qd) + T(g_.kp) * (vecN<T, N>(ref.q) - q);
+    const vecN<T, M> rhs = apply_St(c_, q, vecN<T, N>(a - apply_Sdot(c_, q, qd, eta)));
+    if constexpr (C::orthonormal_S) {
+      return id_(q, eta, rhs);
+    } else {
+      const auto Sq = c_.S(q);
+      const Eigen::Matrix<T, M, M> G = Sq.transpose() * Sq;
+      return id_(q, eta, vecN<T, M>(ldlt_factor<T, M>(G, "SᵀS").solve(rhs)));
+    }
+  }
+
+ private:
+  C c_;
+  decltype(inverse_dynamics(std::declval<const Model&>(), std::declval<const C&>())) id_;
+  ct_gains g_;
+  int n_;
+};
+
+template <class S, int N, class C>
+computed_torque_controller(const chain<S, N>&, C, ct_gains) -> computed_torque_controller<S, N, C>;
+template <class S, class C>
+computed_torque_controller(const tree<S>&, C, ct_gains) -> computed_torque_controller<S, dynamic, C, tree<S>>;
+
+/// Either controller behind one call (a scene picks one at run time; the closed loop is
+/// compiled once for both).
+template <class S, int N, class C, class Model = chain<S, N>>
+class any_controller {
+ public:
+  static constexpr int M = C::m_at_compile_time;
+  using rac = rac_controller<S, N, C, Model>;
+  using computed_torque = computed_torque_controller<S, N, C, Model>;
+
+  any_controller(rac c) : v_(std::move(c)) {}
+  any_controller(computed_torque c) : v_(std::move(c)) {}
+
+  template <class T>
+  vecN<T, M> operator()(const vecN<T, N>& q, const vecN<T, M>& eta, const vec3<T>& r, const task_reference<T>& ref) const {
+    return std::visit([&](const auto& c) { return vecN<T, M>(c(q, eta, r, ref)); }, v_);
+  }
+
+ private:
+  std::variant<rac, computed_torque> v_;
+};
 
 }  // namespace nhdyn

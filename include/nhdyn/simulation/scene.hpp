@@ -84,6 +84,34 @@ struct object {
     }
     return x;
   }
+  /// A list of rows of `cols` numbers each (cols < 0: any, the same for every row), at least `min_rows`.
+  Eigen::MatrixXd rows(const char* k, int cols, int min_rows) const {
+    const json& v = j.at(k);
+    const std::string what = "field '" + name(k) + "' must be a list of at least " + std::to_string(min_rows) +
+                             " lists of " + (cols < 0 ? std::string("numbers (all of one length)") : std::to_string(cols) + " numbers");
+    if (!v.is_array() || int(v.size()) < min_rows || !v[0].is_array() || v[0].empty()) throw input_error(where + what);
+    const int c = cols < 0 ? int(v[0].size()) : cols;
+    Eigen::MatrixXd x(int(v.size()), c);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (!v[i].is_array() || int(v[i].size()) != c)
+        throw input_error(where + what + " (entry " + std::to_string(i) + " has " +
+                          (v[i].is_array() ? std::to_string(v[i].size()) : std::string("no")) + " numbers)");
+      for (int jj = 0; jj < c; ++jj) {
+        const json& e = v[i][std::size_t(jj)];
+        if (!e.is_number() || !std::isfinite(e.get<double>()))
+          throw input_error(where + "field '" + name(k) + "', entry " + std::to_string(i) + ": must hold finite numbers");
+        x(int(i), jj) = e.get<double>();
+      }
+    }
+    return x;
+  }
+  std::vector<double> list(const char* k, int min_size) const {
+    const json& v = j.at(k);
+    if (!v.is_array() || int(v.size()) < min_size)
+      throw input_error(where + "field '" + name(k) + "' must be a list of at least " + std::to_string(min_size) + " numbers");
+    const Eigen::VectorXd x = vector(k, int(v.size()));
+    return {x.data(), x.data() + x.size()};
+  }
   /// A gain: a number (times I₃) or a list of 3 (a diagonal).
   Eigen::Matrix3d gain(const char* k, const Eigen::Matrix3d& fallback) const {
     if (!has(k)) return fallback;
@@ -131,45 +159,68 @@ inline run_spec parse_run(const json& j, const std::vector<std::filesystem::path
   s.name = name;
   const std::string robot = o.text("robot", "paper5");
   const bool paper5 = robot == "paper5";
-  if (!paper5) {  // a robot file: a path (relative to the scene's folder) or a shipped robot's name
+  const auto presets = io::preset_names();
+  if (!paper5 && std::find(presets.begin(), presets.end(), robot) != presets.end()) {
+    s.robot = robot;  // a preset
+  } else if (!paper5) {  // a file: a path (relative to the scene's folder) or a shipped robot's or model's name
     namespace fs = std::filesystem;
     std::error_code ec;
     std::vector<fs::path> tries;
     if (fs::path(robot).is_absolute()) tries.emplace_back(robot);
     for (const auto& d : dirs) tries.push_back(d / robot);
-    if (const auto r = shipped_robots_dir(dirs); !r.empty()) tries.push_back(r / (robot + ".json"));
+    if (const auto r = shipped_robots_dir(dirs); !r.empty()) {
+      tries.push_back(r / (robot + ".json"));
+      tries.push_back(r.parent_path() / "models" / (robot + ".json"));
+    }
     for (const auto& t : tries)
       if (fs::is_regular_file(t, ec)) {
         s.robot = t.string();
         break;
       }
     if (s.robot == "paper5") {
-      std::string looked;
+      std::string looked, known;
       for (const auto& t : tries) looked += (looked.empty() ? "" : ", ") + t.string();
-      throw input_error(where + "field 'robot': '" + robot + "' is neither 'paper5' nor a robot file (looked for " +
+      for (const auto& p : presets) known += ", " + p;
+      throw input_error(where + "field 'robot': '" + robot + "' is neither a preset (paper5" + known +
+                        ") nor a robot file, URDF or JSON model (looked for " +
                         (looked.empty() ? std::string("nothing: no folder") : looked) + ")");
     }
+  }
+  if (!paper5) {
     const auto task = o.sub("task", {"frame", "point"});
     if (!task.has("frame")) throw input_error(where + "field 'task.frame' (a body or frame name carrying r) is required for robot '" + robot + "'");
     s.task_frame = task.text("frame", "");
     if (task.has("point")) s.task_point = task.vector("point", 3);
-    const auto masses = [&](const char* k) {
+    // {"NAME": factor, …} at plant/model.<key>
+    const auto by_name = [&](const char* k, const char* key, const char* what) {
       std::vector<std::pair<std::string, double>> out;
       if (!o.has(k)) return out;
-      const auto f = o.sub(k, {"mass_factor"});
-      if (!f.has("mass_factor")) return out;
-      const json& mf = f.j.at("mass_factor");
+      const auto f = o.sub(k, {"mass_factor", "length_factor", "wheel_radius_factor"});
+      if (!f.has(key)) return out;
+      const json& mf = f.j.at(key);
       if (!mf.is_object())
-        throw input_error(where + "field '" + std::string(k) + ".mass_factor' must be an object {\"BODY\": factor, …} for robot files");
+        throw input_error(where + "field '" + std::string(k) + "." + key + "' must be an object {\"" + what +
+                          "\": factor, …} for this robot");
       for (auto it = mf.begin(); it != mf.end(); ++it) {
         if (!it->is_number() || !(it->get<double>() > 0) || !std::isfinite(it->get<double>()))
-          throw input_error(where + "field '" + std::string(k) + ".mass_factor." + it.key() + "' must be a finite number > 0");
+          throw input_error(where + "field '" + std::string(k) + "." + key + "." + it.key() + "' must be a finite number > 0");
         out.emplace_back(it.key(), it->get<double>());
       }
       return out;
     };
-    s.plant_mass = masses("plant");
-    s.model_mass = masses("model");
+    const auto radius = [&](const char* k) {
+      if (!o.has(k)) return 1.0;
+      const auto f = o.sub(k, {"mass_factor", "length_factor", "wheel_radius_factor"});
+      const double r = f.number("wheel_radius_factor", 1);
+      if (!(r > 0)) throw input_error(where + "field '" + std::string(k) + ".wheel_radius_factor' must be > 0");
+      return r;
+    };
+    s.plant_mass = by_name("plant", "mass_factor", "BODY");
+    s.model_mass = by_name("model", "mass_factor", "BODY");
+    s.plant_length = by_name("plant", "length_factor", "JOINT");
+    s.model_length = by_name("model", "length_factor", "JOINT");
+    s.plant_wheel_radius = radius("plant");
+    s.model_wheel_radius = radius("model");
     s.plant = s.model = presets::paper5_parameters<double>{};  // not used: no paper5 factors
   } else {
     if (o.has("task")) throw input_error(where + "field 'task': paper5's task point is the origin of link 5 (not settable)");
@@ -177,7 +228,23 @@ inline run_spec parse_run(const json& j, const std::vector<std::filesystem::path
     if (o.has("model")) s.model = detail::read_factors(o.sub("model", detail::factor_keys));
   }
 
-  const auto c = o.sub("controller", {"K0", "K1", "lambda", "kN", "kP", "posture_joints", "robust"});
+  const auto c = o.sub("controller", {"type", "K0", "K1", "lambda", "kN", "kP", "posture_joints", "robust", "kp", "kd"});
+  if (const auto type = c.text("type", "task_space"); type == "computed_torque") {
+    s.controller = controller_type::computed_torque;
+    for (const char* k : {"K0", "K1", "lambda", "kN", "kP", "posture_joints", "robust"})
+      if (c.has(k))
+        throw input_error(where + "field 'controller." + std::string(k) + "' belongs to the task-space controller (type 'computed_torque' takes kp, kd)");
+    s.ct.kp = c.number("kp", s.ct.kp);
+    s.ct.kd = c.number("kd", s.ct.kd);
+    if (!(s.ct.kp >= 0) || !(s.ct.kd >= 0)) throw input_error(where + "fields 'controller.kp', 'controller.kd' must be ≥ 0");
+  } else if (type != "task_space") {
+    throw input_error(where + "field 'controller.type' must be 'task_space' or 'computed_torque' (got '" + type + "')");
+  } else {
+    for (const char* k : {"kp", "kd"})
+      if (c.has(k))
+        throw input_error(where + "field 'controller." + std::string(k) +
+                          "' belongs to the computed-torque controller (controller.type 'computed_torque'); the task-space controller's posture stiffness is 'kP'");
+  }
   s.gains.K0 = c.gain("K0", s.gains.K0);
   s.gains.K1 = c.gain("K1", s.gains.K1);
   s.gains.lambda = c.number("lambda", s.gains.lambda);
@@ -205,17 +272,53 @@ inline run_spec parse_run(const json& j, const std::vector<std::filesystem::path
   s.gains.robust = {rb.number("alpha", 0), rb.number("gamma0", 0), rb.number("gamma1", 0.1),
                     rb.number("gamma2", 0.2), rb.number("epsilon", 0)};
 
-  const auto r = o.sub("reference", {"type", "center", "u", "v", "radius", "period", "phase"});
-  if (const auto type = r.text("type", "circle"); type != "circle")
-    throw input_error(where + "field 'reference.type': only 'circle' is known (got '" + type + "')");
-  if (r.has("center")) s.reference.center = r.vector("center", 3);
-  if (r.has("u")) s.reference.u = r.vector("u", 3);
-  if (r.has("v")) s.reference.v = r.vector("v", 3);
-  s.reference.radius = r.number("radius", s.reference.radius);
-  const double period = r.number("period", 20);
-  if (!(period != 0)) throw input_error(where + "field 'reference.period' must not be 0");
-  s.reference.omega = 2 * 3.14159265358979323846 / period;
-  s.reference.phase = r.number("phase", 0);
+  const std::string rtype = o.has("reference") && o.j.at("reference").is_object() && o.j.at("reference").contains("type") &&
+                                  o.j.at("reference").at("type").is_string()
+                              ? o.j.at("reference").at("type").get<std::string>()
+                              : "circle";
+  if (rtype == "circle") {
+    const auto r = o.sub("reference", {"type", "center", "u", "v", "radius", "period", "phase"});
+    circle_reference cr;
+    if (r.has("center")) cr.center = r.vector("center", 3);
+    if (r.has("u")) cr.u = r.vector("u", 3);
+    if (r.has("v")) cr.v = r.vector("v", 3);
+    cr.radius = r.number("radius", cr.radius);
+    const double period = r.number("period", 20);
+    if (!(period != 0)) throw input_error(where + "field 'reference.period' must not be 0");
+    cr.omega = 2 * 3.14159265358979323846 / period;
+    cr.phase = r.number("phase", 0);
+    s.reference = cr;
+  } else if (rtype == "line") {
+    const auto r = o.sub("reference", {"type", "from", "to", "start", "end"});
+    for (const char* k : {"from", "to", "end"})
+      if (!r.has(k)) throw input_error(where + "field 'reference." + std::string(k) + "' is required for a line");
+    line_reference l;
+    l.from = r.vector("from", 3), l.to = r.vector("to", 3);
+    l.start = r.number("start", 0), l.end = r.number("end", 0);
+    if (!(l.end > l.start)) throw input_error(where + "field 'reference.end' must be later than 'reference.start'");
+    s.reference = l;
+  } else if (rtype == "spline" || rtype == "joint_spline") {
+    const bool joint = rtype == "joint_spline";
+    const char* pts = joint ? "q" : "points";
+    const auto r = o.sub("reference", {"type", "times", pts});
+    for (const char* k : {"times", pts})
+      if (!r.has(k)) throw input_error(where + "field 'reference." + std::string(k) + "' is required for a " + rtype);
+    const std::vector<double> times = r.list("times", 2);
+    const Eigen::MatrixXd y = r.rows(pts, joint ? (paper5 ? 5 : -1) : 3, 2);
+    if (y.rows() != Eigen::Index(times.size()))
+      throw input_error(where + "fields 'reference.times' and 'reference." + pts + "': " + std::to_string(times.size()) +
+                        " times for " + std::to_string(y.rows()) + " waypoints");
+    try {
+      if (joint) s.reference = joint_spline_reference(times, y);
+      else s.reference = spline_reference(times, y);
+    } catch (const input_error& e) {
+      throw input_error(where + "field 'reference': " + e.what());
+    }
+  } else {
+    throw input_error(where + "field 'reference.type' must be 'circle', 'line', 'spline' or 'joint_spline' (got '" + rtype + "')");
+  }
+  if (s.controller == controller_type::computed_torque && !is_joint_space(s.reference))
+    throw input_error(where + "the computed-torque controller needs a joint-space reference (reference.type 'joint_spline')");
 
   const auto init = o.sub("initial", {"q", "eta"});
   if (paper5) {

@@ -45,26 +45,36 @@ struct run_options {
   double tail_from = 15, tail_tolerance = 0.01;  ///< success: max ‖r̃‖ over [tail_from, end] below this
 };
 
+/// Which controller a scene runs (controller.hpp).
+enum class controller_type {
+  task_space,      ///< the paper's robust task-space controller (rac_controller)
+  computed_torque  ///< joint-space computed torque (computed_torque_controller; needs a joint-space reference)
+};
+
 /// Everything that defines one run (a scene, once parsed): defaults are paper-circle.
 struct run_spec : run_options {
   std::string name = "paper-circle";
   presets::paper5_parameters<double> plant{{1.1, 1.1, 1.1, 1.1, 1.1}, 1, 1, 1};
   presets::paper5_parameters<double> model{};  ///< the controller's (nominal) model
-  rac_gains gains{};
+  controller_type controller = controller_type::task_space;
+  rac_gains gains{};     ///< the task-space controller's
+  ct_gains ct{};         ///< the computed-torque controller's
   vecN<double, 5> posture_mask = (vecN<double, 5>() << 0, 0, 0, 1, 1).finished();
-  circle_reference reference{};
+  reference_spec reference = circle_reference{};
   vecN<double, 5> q0 = (vecN<double, 5>() << -0.23710299623923958, 1.0, 3.141592653589793,
                         2.058145585963254, 1.2).finished();
   vecN<double, 4> eta0 = vecN<double, 4>::Zero();
 
   // Any robot (scene field "robot" other than "paper5"; simulation/robot_scene.hpp runs it).
-  // plant/model, q0, eta0 and posture_mask above are paper5's; for a robot file these are:
-  std::string robot = "paper5";  ///< "paper5", or a robot file's path
+  // plant/model, q0, eta0 and posture_mask above are paper5's; for any other robot these are:
+  std::string robot = "paper5";  ///< "paper5", a preset's name, or a robot file's, URDF's or JSON model's path
   std::string task_frame;        ///< the body or frame carrying r
   vec3<double> task_point = vec3<double>::Zero();  ///< r in that frame
   Eigen::VectorXd q_start, eta_start;              ///< the initial state (empty: zeros)
   std::vector<std::string> posture_joints;         ///< joints the posture term holds at q_start
   std::vector<std::pair<std::string, double>> plant_mass, model_mass;  ///< mass factors by body name
+  std::vector<std::pair<std::string, double>> plant_length, model_length;  ///< joint placement factors by joint name
+  double plant_wheel_radius = 1, model_wheel_radius = 1;  ///< factors on the constraint's wheel radius
 
   // Where the run came from in a study (scene.hpp), for summary.json:
   std::optional<std::uint64_t> run_seed;  ///< a Monte Carlo run's seed (replays it alone)
@@ -289,6 +299,16 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
 }
 
 namespace detail {
+/// Throws input_error unless the scene's reference suits its controller and its robot's n joints.
+inline void check_reference(const run_spec& s, int n) {
+  const std::string where = "scene '" + s.name + "': ";
+  if (s.controller == controller_type::computed_torque && !is_joint_space(s.reference))
+    throw input_error(where + "the computed-torque controller needs a joint-space reference (reference.type 'joint_spline')");
+  if (const auto* j = std::get_if<joint_spline_reference>(&s.reference); j && j->dof() != n)
+    throw input_error(where + "field 'reference.q': waypoints of " + std::to_string(j->dof()) + " joints, the robot has " +
+                      std::to_string(n));
+}
+
 /// f()'s run_result with its wall and CPU times those of the whole call (set-up included).
 template <class F>
 run_result timed(const F& f) {
@@ -314,24 +334,46 @@ struct simulate_fn {
       if (s.robot != "paper5")
         throw input_error("scene '" + s.name + "': robot '" + s.robot +
                           "' is a robot file: simulate_scene (simulation/robot_scene.hpp, needs URDF support) runs it");
+      detail::check_reference(s, 5);
       const auto plant = presets::paper5<double>(s.plant);
       const auto nominal = presets::paper5<double>(s.model);
-      const kinematics<double, 5> plant_kin(plant.chain);
+      const kinematics<double, 5> plant_kin(plant.chain), model_kin(nominal.chain);
       const auto fd = nh_forward_dynamics(plant.chain, plant.constraint);
-      const rac_controller ctrl(nominal.chain, nominal.constraint, s.gains, s.q0, s.posture_mask);
       const auto task = [&](const auto& q) { return plant_kin.point(q, 5); };
-      return simulate_closed_loop<5, 4>(s.name, plant.constraint, fd, task, ctrl, s.reference, s.q0, s.eta0,
-                                        options_of(s), run_columns());
+      const scene_reference ref(s.reference, model_kin, 5, vec3<double>::Zero());
+      using C = decltype(plant.constraint);
+      const any_controller<double, 5, C> ctrl =
+          s.controller == controller_type::task_space
+              ? any_controller<double, 5, C>(rac_controller(nominal.chain, nominal.constraint, s.gains, s.q0, s.posture_mask))
+              : any_controller<double, 5, C>(computed_torque_controller(nominal.chain, nominal.constraint, s.ct));
+      return simulate_closed_loop<5, 4>(s.name, plant.constraint, fd, task, ctrl, ref, s.q0, s.eta0, options_of(s),
+                                        run_columns());
     });
   }
 };
 inline constexpr simulate_fn simulate{};
 
-/// One closed-loop run of any robot (a kinematic tree with its constraint: a robot file's):
-/// the robust task-space controller (controller.hpp) on `nominal` drives the point `point` of
-/// body `body` (1-based, tree_kinematics' numbering; tree::find_frame turns a frame name into
-/// one) of `plant` along `reference`. The posture term holds the joints whose `posture_mask`
-/// entry is 1 at q0. Plant–model mismatch: give `plant` and `nominal` different inertias.
+/// One closed-loop run of any robot (a kinematic tree `plant` with its constraint `c`), with
+/// any controller `(q, η, r_measured, reference(t)) → τ` (controller.hpp's, or a user's
+/// function object) and any reference: r is the point `point` of body `body` (1-based,
+/// tree_kinematics' numbering; tree::find_frame turns a frame name into one) on the plant.
+/// Everything the controller knows (its model, constraint, gains) is inside it: plant–model
+/// mismatch is a controller built on another tree or constraint.
+template <class C, class Controller, class Reference>
+run_result simulate_robot(const std::string& name, const tree<double>& plant, const C& c, int body,
+                          const vec3<double>& point, const Controller& controller, const Reference& reference,
+                          const Eigen::VectorXd& q0, const Eigen::VectorXd& eta0, const run_options& o,
+                          const std::vector<std::string>& eta_names) {
+  const tree_kinematics<double> plant_kin(plant);
+  const auto fd = nh_forward_dynamics(plant, c);
+  const auto task = [&](const auto& q) { return plant_kin.point(q, body, point); };
+  return simulate_closed_loop<dynamic, dynamic>(name, c, fd, task, controller, reference, q0, eta0, o,
+                                                run_columns(plant.joint_names(), eta_names));
+}
+
+/// The same with the robust task-space controller (controller.hpp) on `nominal` (same
+/// constraint), driving that point along `reference`; the posture term holds the joints whose
+/// `posture_mask` entry is 1 at q0.
 template <class C, class Reference = circle_reference>
 run_result simulate_robot(const std::string& name, const tree<double>& plant, const tree<double>& nominal, const C& c,
                           int body, const vec3<double>& point, const Reference& reference, const rac_gains& gains,
@@ -340,12 +382,8 @@ run_result simulate_robot(const std::string& name, const tree<double>& plant, co
   if (plant.dof() != nominal.dof())
     throw input_error("scene '" + name + "': plant and model have " + std::to_string(plant.dof()) + " and " +
                       std::to_string(nominal.dof()) + " joints");
-  const tree_kinematics<double> plant_kin(plant);
-  const auto fd = nh_forward_dynamics(plant, c);
   const rac_controller ctrl(nominal, c, gains, q0, posture_mask, body, point);
-  const auto task = [&](const auto& q) { return plant_kin.point(q, body, point); };
-  return simulate_closed_loop<dynamic, dynamic>(name, c, fd, task, ctrl, reference, q0, eta0, o,
-                                                run_columns(plant.joint_names(), eta_names));
+  return simulate_robot(name, plant, c, body, point, ctrl, reference, q0, eta0, o, eta_names);
 }
 
 /// Shortest round-trip decimal form of x (std::to_chars): parsing it gives x back exactly.
