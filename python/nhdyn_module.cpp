@@ -430,6 +430,46 @@ nhdyn::scene::search_path scene_dirs(const std::string& module_file) {
   return dirs;
 }
 
+#if NHDYN_PY_URDF
+/// A Python callable as the closed loop's controller: controller(q, eta, r, ref) -> tau, with
+/// ref a dict of the reference at this instant ("r", "rd", "rdd"; "q", "qd", "qdd" for a
+/// joint-space reference). Called with the GIL held; a Python exception becomes the run's
+/// failure (its message), never escapes into the integrator as a Python object.
+struct python_controller {
+  py::object f;
+  int m = 0;
+  template <class T>
+  Eigen::Matrix<T, Eigen::Dynamic, 1> operator()(const Eigen::Matrix<T, Eigen::Dynamic, 1>& q,
+                                                 const Eigen::Matrix<T, Eigen::Dynamic, 1>& eta, const nhdyn::vec3<T>& r,
+                                                 const nhdyn::task_reference<T>& ref) const {
+    if constexpr (!std::is_same_v<T, double>) {
+      throw nhdyn::input_error("a Python controller runs in double only (rk4 or dopri5, not rosenbrock4)");
+    } else {
+      py::gil_scoped_acquire gil;
+      try {
+        const auto arr = [](const auto& v) {
+          py::array_t<double> a(py::ssize_t(v.size()));
+          std::copy(v.data(), v.data() + v.size(), a.mutable_data());
+          return a;
+        };
+        py::dict d;
+        d["r"] = arr(ref.r), d["rd"] = arr(ref.rd), d["rdd"] = arr(ref.rdd);
+        if (ref.q.size() > 0) d["q"] = arr(ref.q), d["qd"] = arr(ref.qd), d["qdd"] = arr(ref.qdd);
+        const py::object out = f(arr(q), arr(eta), arr(r), d);
+        const auto tau = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(out);
+        if (!tau || tau.ndim() != 1 || tau.shape(0) != m)
+          throw nhdyn::input_error("the Python controller must return " + std::to_string(m) + " numbers (one per entry of eta)");
+        Eigen::VectorXd t(m);
+        std::copy(tau.data(), tau.data() + m, t.data());
+        return t;
+      } catch (py::error_already_set& e) {
+        throw std::runtime_error(std::string("Python controller: ") + e.what());
+      }
+    }
+  }
+};
+#endif
+
 /// A run's result as a dict of NumPy arrays (see nhdyn.simulate's docstring).
 py::dict result_dict(const nhdyn::run_spec& spec, nhdyn::run_result& r) {
   py::dict d;
@@ -622,7 +662,7 @@ f(q_lo, q_hi, qd_lo, qd_hi, qdd_lo, qdd_hi) -> rne bounds (n entries). `split` b
 box 2^split times (tighter bounds, 2^split evaluations). Batches: one box per row. Raises
 InputError for lo > hi or NaN, NumericalError for a box too wide to bound.)");
   mod.def("simulate",
-          [](const py::object& scene, int threads) {
+          [](const py::object& scene, int threads, const py::object& controller) {
             const std::string module_file = py::module_::import("nhdyn").attr("__file__").cast<std::string>();
             auto dirs = scene_dirs(module_file);
             nhdyn::scene::json j;
@@ -636,7 +676,20 @@ InputError for lo > hi or NaN, NumericalError for a box too wide to bound.)");
             }
             const auto specs = nhdyn::scene::expand(j, dirs);
             std::vector<nhdyn::run_result> results;
-            {
+            if (!controller.is_none()) {
+#if NHDYN_PY_URDF
+              if (!PyCallable_Check(controller.ptr())) throw nhdyn::input_error("nhdyn.simulate: controller must be callable");
+              const auto with_python = [&](const nhdyn::run_spec& s) {
+                return nhdyn::simulate_scene_with(s, [&](const auto&, const auto& c, int, const auto&, const auto&, const auto&) {
+                  return python_controller{controller, c.m()};
+                });
+              };
+              py::gil_scoped_release release;  // the callbacks take it back
+              results = nhdyn::run_batch(specs, 1, [](std::size_t, nhdyn::run_result&) {}, with_python);
+#else
+              throw nhdyn::input_error("nhdyn.simulate: a Python controller needs nhdyn built with URDF support");
+#endif
+            } else {
               py::gil_scoped_release release;
 #if NHDYN_PY_URDF
               results = nhdyn::run_batch(specs, unsigned(std::max(0, threads)), [](std::size_t, nhdyn::run_result&) {},
@@ -649,8 +702,8 @@ InputError for lo > hi or NaN, NumericalError for a box too wide to bound.)");
             for (std::size_t i = 0; i < results.size(); ++i) out.append(result_dict(specs[i], results[i]));
             return out;
           },
-          py::arg("scene"), py::arg("threads") = 0,
-          R"(simulate(scene, threads=0) -> list of dicts, one per run
+          py::arg("scene"), py::arg("threads") = 0, py::arg("controller") = py::none(),
+          R"(simulate(scene, threads=0, controller=None) -> list of dicts, one per run
 
 Runs a scene, study or suite (docs/simulation.md): `scene` is a file path, the name of a
 shipped scene ("paper-circle", "paper", "mobile-manipulator-circle", ...) or a dict in the
@@ -660,5 +713,12 @@ Each run: {"name", "success", "failure" (str or None), "max_tail_error" [m], "pe
 columns), and the blocks "t" [s], "q", "eta", "tau", "r", "rd" [m] (rows x 3), "err" [m]}.
 A failing run is reported, not raised: "success" False and "failure" the reason (a run that
 cannot be set up — an unknown frame, a wrong initial size — says "setup: ..." and has no
-rows); a scene file that cannot be read or parsed raises InputError naming the field.)");
+rows); a scene file that cannot be read or parsed raises InputError naming the field.
+
+controller: a Python function controller(q, eta, r, ref) -> tau (m entries) used instead of
+the scene's controller, on every run (one at a time: it holds the GIL): q (n), eta (m) the
+state, r (3) the measured task point [m], ref a dict of the reference at this instant: "r",
+"rd", "rdd" (3 each) and, for a joint_spline reference, "q", "qd", "qdd" (n each). The
+scene's robot runs as a kinematic tree (paper5 included), integrated by rk4 or dopri5. An
+exception in it fails the run with its message.)");
 }

@@ -22,6 +22,26 @@ if(TARGET nhdyn_tool)
               -DRUN=mobile-manipulator-circle -DOUT=${CMAKE_CURRENT_BINARY_DIR}/simulate_cli_mm -DEXPECT_RC=0
               "-DEXPECT_TEXT=mobile-manipulator-circle: 1/1 succeeded"
               "-DEXPECT_HEADER_START=t,q_base_x,q_base_y,q_base_yaw,q_wheel_left_joint," -P ${_sim_check})
+    # Any model: a URDF arm (holonomic) on a line; a preset under computed torque, with mismatch
+    add_test(NAME simulate_cli_urdf_arm_line
+      COMMAND ${CMAKE_COMMAND} -DTOOL=$<TARGET_FILE:nhdyn_tool> -DSCENE=puma560-line -DRUN=puma560-line
+              -DOUT=${CMAKE_CURRENT_BINARY_DIR}/simulate_cli_puma_line -DEXPECT_RC=0 "-DEXPECT_TEXT=puma560-line: 1/1 succeeded"
+              "-DEXPECT_HEADER_START=t,q_joint1,q_joint2,q_joint3,q_joint4,q_joint5,q_joint6,eta_joint1," -P ${_sim_check})
+    add_test(NAME simulate_cli_computed_torque
+      COMMAND ${CMAKE_COMMAND} -DTOOL=$<TARGET_FILE:nhdyn_tool> -DSCENE=puma560-computed-torque -DRUN=puma560-computed-torque
+              -DOUT=${CMAKE_CURRENT_BINARY_DIR}/simulate_cli_puma_ct -DEXPECT_RC=0
+              "-DEXPECT_TEXT=puma560-computed-torque: 1/1 succeeded" -P ${_sim_check})
+  endif()
+  # Percentile-band figures for many runs: bands = NumPy's percentiles of the runs' CSVs.
+  find_package(Python3 COMPONENTS Interpreter QUIET)
+  if(Python3_Interpreter_FOUND)
+    execute_process(COMMAND ${Python3_EXECUTABLE} -c "import numpy" RESULT_VARIABLE _no_numpy OUTPUT_QUIET ERROR_QUIET)
+    if(_no_numpy EQUAL 0)
+      add_test(NAME simulate_cli_percentile_bands
+        COMMAND ${CMAKE_COMMAND} -DTOOL=$<TARGET_FILE:nhdyn_tool> -DSCENE=${CMAKE_CURRENT_SOURCE_DIR}/scenes/bands-monte-carlo.json
+                -DOUT=${CMAKE_CURRENT_BINARY_DIR}/simulate_cli_bands -DGROUP=bands-mc -DRUNS=24 -DPYTHON=${Python3_EXECUTABLE}
+                -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/simulate_bands_check.cmake)
+    endif()
   endif()
   # MPI: a Monte Carlo study on 1 process and under mpirun -n 2, the same runs bit for bit
   # (not under sanitizers: Open MPI's start-up is not leak-clean).

@@ -215,7 +215,8 @@ TEST_CASE("references: a joint spline's task image is r(q_d) with ṙ_d, r̈_d i
   const kinematics<double, 5> kin(robot.chain);
   Eigen::MatrixXd q(3, 5);
   q << 0, 0, 0, 1.0, 0.5, 0.2, 0.1, 0.3, 1.4, 0.2, 0.4, 0.1, 0.5, 0.9, 0.8;
-  const scene_reference ref(joint_spline_reference({0, 1, 2.5}, q), kin, 5, vec3<double>::Zero());
+  const reference_spec spec = joint_spline_reference({0, 1, 2.5}, q);
+  const scene_reference ref(spec, kin, 5, vec3<double>::Zero());
   for (double t : {0.4, 1.3, 2.2}) {
     const auto r = ref(t);
     REQUIRE(r.q.size() == 5);
@@ -243,7 +244,8 @@ TEST_CASE("computed torque: on its own model the joint error obeys ë + k_D ė +
   e0 << 0.1, -0.05, 0.08, -0.1, 0.06, 0.02;
   Eigen::MatrixXd hold(2, 6);
   hold << qd.transpose(), qd.transpose();
-  const scene_reference ref(joint_spline_reference({0, 1}, hold), kin, 6, vec3<double>::Zero());
+  const reference_spec spec = joint_spline_reference({0, 1}, hold);
+  const scene_reference ref(spec, kin, 6, vec3<double>::Zero());
   const computed_torque_controller ctrl(t, c, ct_gains{100, 20});
   run_options o;
   o.duration = 1, o.tail_from = 0.5, o.tail_tolerance = 1;
@@ -273,7 +275,8 @@ TEST_CASE("computed torque: on paper5, the arm follows a moving joint spline wit
   w << s.q0.transpose(), s.q0.transpose(), s.q0.transpose();
   w(1, 3) += 0.4, w(1, 4) -= 0.3, w(2, 3) -= 0.2, w(2, 4) += 0.5;
   s.reference = joint_spline_reference({0, 1, 2}, w);
-  const scene_reference ref(s.reference, kinematics<double, 5>(presets::paper5<double>().chain), 5, vec3<double>::Zero());
+  const kinematics<double, 5> kin(presets::paper5<double>().chain);
+  const scene_reference ref(s.reference, kin, 5, vec3<double>::Zero());
   const double e4 = 0.05, e5 = -0.04;
   s.q0(3) += e4, s.q0(4) += e5;
   s.duration = 2.5, s.tail_from = 2, s.tail_tolerance = 1;

@@ -240,7 +240,8 @@ TEST_CASE("robot simulation: a wheel-radius mismatch — the plant rolls on its 
   REQUIRE(r.success);
   // The base's forward speed u = cos ψ ẋ + sin ψ ẏ (central differences of the rows) is the
   // plant's wheel kinematics, r_plant (φ̇_L s_L + φ̇_R s_R)/2 at a centred axle: not the model's.
-  const auto& w = std::get<rolling_wheels<double>>(*io::load_robot_file(s.robot).constraint);
+  const io::robot_model wheels = io::load_robot_file(s.robot);
+  const auto& w = std::get<rolling_wheels<double>>(*wheels.constraint);
   REQUIRE(std::abs(w.left_y + w.right_y) < 1e-12);
   const int x = column(r, "q_base_x"), y = column(r, "q_base_y"), yaw = column(r, "q_base_yaw");
   const int wl = column(r, "eta_wheel_left_joint"), wr = column(r, "eta_wheel_right_joint");

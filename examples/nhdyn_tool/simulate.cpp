@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -47,7 +48,10 @@ constexpr std::string_view usage = R"(nhdyn simulate SCENE... --out DIR [--threa
                         "aggregate": {count, succeeded, success_rate, max_tail_error and
                         peak_tau percentiles (min, p5, p50, p95, max), wall_time_s, cpu_time_s}}
     DIR/<group>-path.png, -error.png, -q.png, -tau.png   figs. 4-6 and tau(t) (gnuplot; one
-                        set per scene or study, each run one colour, named in the legend)
+                        set per scene or study, each run one colour, named in the legend;
+                        from 21 runs on: percentile bands per output time instead, min-max,
+                        5-95 % and the median, over the runs that reached the end, from
+                        DIR/<group>-bands.csv: t, then <column>_min,_p5,_p50,_p95,_max)
   A study's runs go in parallel on --threads workers (default: all cores), with a progress
   bar and an ETA when stderr is a terminal. Under MPI (mpirun -n N nhdyn simulate ...) the
   runs are handed out one at a time to N processes on any machines (rank 0 runs them too),
@@ -150,6 +154,134 @@ std::string gnuplot_program(const std::filesystem::path& dir, const group& g, co
   return p.str();
 }
 
+/// Groups of more runs than this get percentile bands instead of one line per run.
+constexpr std::size_t band_from = 21;
+
+/// The numbers of a CSV written by write_csv (header skipped), one row per line; empty if the
+/// file is not there or not such a CSV.
+std::vector<std::vector<double>> read_rows(const std::filesystem::path& file) {
+  std::vector<std::vector<double>> rows;
+  std::ifstream in(file);
+  std::string line;
+  if (!std::getline(in, line)) return rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    const char* c = line.data();
+    const char* const end = line.data() + line.size();
+    while (c < end) {
+      double x = 0;
+      const auto [next, ec] = std::from_chars(c, end, x);
+      if (ec != std::errc() || (next < end && *next != ',')) return {};
+      row.push_back(x);
+      c = next < end ? next + 1 : next;
+    }
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+/// DIR/<group>-bands.csv: per output time, the min, p5, p50, p95 and max of every column over
+/// the group's runs that reached the last output time (read back from their CSVs: under MPI
+/// each was written where it ran, so this needs them in one folder). Returns how many runs
+/// it used; 0 when no run had rows.
+std::size_t write_bands(const std::filesystem::path& dir, const group& g, const std::vector<std::string>& names,
+                        const std::vector<std::string>& columns) {
+  std::vector<std::vector<std::vector<double>>> runs;
+  std::size_t longest = 0;
+  for (auto i : g.runs) {
+    auto rows = read_rows(dir / (names[i] + ".csv"));
+    longest = std::max(longest, rows.size());
+    runs.push_back(std::move(rows));
+  }
+  std::erase_if(runs, [&](const auto& r) { return r.size() != longest || longest == 0; });
+  if (runs.empty()) return 0;
+  std::ofstream out(dir / (g.name + "-bands.csv"));
+  out << "t";
+  for (std::size_t j = 1; j < columns.size(); ++j)
+    for (const char* q : {"_min", "_p5", "_p50", "_p95", "_max"}) out << ',' << columns[j] << q;
+  out << '\n' << std::setprecision(9);
+  std::vector<double> v;
+  for (std::size_t k = 0; k < longest; ++k) {
+    out << runs[0][k][0];
+    for (std::size_t j = 1; j < columns.size(); ++j) {
+      v.clear();
+      for (const auto& r : runs)
+        if (j < r[k].size() && std::isfinite(r[k][j])) v.push_back(r[k][j]);
+      if (v.empty()) {
+        out << ",nan,nan,nan,nan,nan";
+        continue;
+      }
+      std::sort(v.begin(), v.end());
+      const auto at = [&](double f) {  // linear interpolation between order statistics (as summary.json)
+        const double x = f * double(v.size() - 1);
+        const std::size_t i = std::size_t(x);
+        return i + 1 < v.size() ? v[i] + (x - double(i)) * (v[i + 1] - v[i]) : v[i];
+      };
+      out << ',' << v.front() << ',' << at(0.05) << ',' << at(0.5) << ',' << at(0.95) << ',' << v.back();
+    }
+    out << '\n';
+  }
+  return runs.size();
+}
+
+/// gnuplot program for a group of many runs: the same four figures, each column as bands
+/// (min-max, 5-95 %, median) over the runs; the path figure shows r_d and 40 runs' paths.
+std::string gnuplot_bands(const std::filesystem::path& dir, const group& g, const std::vector<std::string>& names,
+                          const std::vector<std::string>& columns, std::size_t used) {
+  std::ostringstream p;
+  const std::string prefix = (dir / g.name).string(), bands = prefix + "-bands.csv";
+  const bool paper5 = columns == nhdyn::run_columns();
+  const auto col = [&](const std::string& name) {
+    for (std::size_t j = 0; j < columns.size(); ++j)
+      if (columns[j] == name) return int(j) + 1;
+    return 0;
+  };
+  // column c (1-based in a run's CSV, c ≥ 2) → its five columns in bands.csv (q: 0 min … 4 max)
+  const auto band = [&](int c, int q) { return 2 + 5 * (c - 2) + q; };
+  const std::string of = std::to_string(used) + " of " + std::to_string(g.runs.size()) + " runs";
+  const auto plot_band = [&](int c, bool key) {
+    p << "plot '" << bands << "' every ::1 using 1:" << band(c, 0) << ":" << band(c, 4)
+      << " with filledcurves lc rgb '#deebf7' " << (key ? "title 'min-max'" : "notitle") << ", \\\n  '' every ::1 using 1:"
+      << band(c, 1) << ":" << band(c, 3) << " with filledcurves lc rgb '#9ecae1' " << (key ? "title '5-95 %'" : "notitle")
+      << ", \\\n  '' every ::1 using 1:" << band(c, 2) << " with lines lw 2 lc rgb '#08519c' "
+      << (key ? "title 'median'" : "notitle") << "\n";
+  };
+  p << "set terminal pngcairo size 900,700 noenhanced font ',10'\nset datafile separator ','\nset grid\nset key top right\n";
+  // the path: r_d and the paths of (up to) 40 runs, thin
+  const std::size_t shown = std::min<std::size_t>(40, g.runs.size());
+  const int rx = col(paper5 ? "r_y" : "r_x"), ry = col(paper5 ? "r_z" : "r_y");
+  const int dx = col(paper5 ? "rd_y" : "rd_x"), dy = col(paper5 ? "rd_z" : "rd_y");
+  p << "files = '";
+  for (std::size_t k = 0; k < shown; ++k) p << (dir / (names[g.runs[k]] + ".csv")).string() << ' ';
+  p << "'\nn = words(files)\nset output '" << prefix << "-path.png'\nset title '" << g.name
+    << ": task point seen from above (" << shown << " of " << g.runs.size() << " runs)'\nset xlabel '"
+    << (paper5 ? "y0" : "x") << " [m]'\nset ylabel '" << (paper5 ? "z0" : "y") << " [m]'\nset size ratio -1\n"
+    << "plot for [i=1:n] word(files,i) every ::1 using " << rx << ":" << ry
+    << " with lines lw 1 lc rgb '#80808080' notitle, \\\n  word(files,1) every ::1 using " << dx << ":" << dy
+    << " with lines dt 2 lw 2 lc rgb 'black' title 'r_d'\nset size noratio\n";
+  p << "set output '" << prefix << "-error.png'\nset title '" << g.name << ": tracking error |r_d - r| over " << of
+    << "'\nset xlabel 't [s]'\nset ylabel '|r_d - r| [m]'\nset logscale y\n";
+  plot_band(col("err"), true);
+  p << "unset logscale y\n";
+  const auto grid = [&](const char* file, const char* what, const std::string& prefix_of) {
+    std::vector<int> cs;
+    for (std::size_t j = 1; j < columns.size(); ++j)
+      if (columns[j].rfind(prefix_of, 0) == 0) cs.push_back(int(j) + 1);
+    const int per_row = cs.size() > 4 ? 3 : 1, rows = (int(cs.size()) + per_row - 1) / per_row;
+    p << "set terminal pngcairo size " << (per_row > 1 ? 1400 : 900) << "," << std::max(400, 170 * rows)
+      << " noenhanced font ',9'\nset output '" << prefix << file << "'\nset multiplot layout " << rows << "," << per_row
+      << " title '" << g.name << ": " << what << ", " << of << " (median, 5-95 %, min-max)'\nunset title\nset xlabel ''\nset key off\n";
+    for (int c : cs) {
+      p << "set ylabel '" << columns[std::size_t(c - 1)].substr(paper5 ? 0 : prefix_of.size()) << "'\n";
+      plot_band(c, false);
+    }
+    p << "unset multiplot\nset key\n";
+  };
+  grid("-q.png", "joint coordinates q (t)", paper5 ? "q" : "q_");
+  grid("-tau.png", "actuator forces and torques applied (t)", paper5 ? "tau" : "tau_");
+  return p.str();
+}
+
 void plot(const std::filesystem::path& dir, const std::vector<group>& groups, const std::vector<std::string>& names,
           const std::vector<nhdyn::run_result>& results) {
   for (const auto& g : groups) {
@@ -162,7 +294,16 @@ void plot(const std::filesystem::path& dir, const std::vector<group>& groups, co
       continue;
     }
     const auto script = dir / (g.name + ".gp");
-    std::ofstream(script) << gnuplot_program(dir, g, names, columns);
+    if (g.runs.size() >= band_from) {
+      const std::size_t used = write_bands(dir, g, names, columns);
+      if (used == 0) {
+        std::cerr << "nhdyn simulate: figures for '" << g.name << "' not made (no run's CSV in " << dir.string() << ")\n";
+        continue;
+      }
+      std::ofstream(script) << gnuplot_bands(dir, g, names, columns, used);
+    } else {
+      std::ofstream(script) << gnuplot_program(dir, g, names, columns);
+    }
     const std::string cmd = "gnuplot '" + script.string() + "' 2>&1";
     if (FILE* pipe = popen(cmd.c_str(), "r")) {
       std::string out;

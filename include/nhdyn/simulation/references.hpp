@@ -186,16 +186,17 @@ inline bool is_joint_space(const reference_spec& r) { return std::holds_alternat
 
 /// The reference a closed loop evaluates: `spec`'s r_d(t) (and q_d(t)); for a joint spline the
 /// task image of q_d is the point `point` on body `body` of the kinematics `kin` (the
-/// controller's model; kept by reference, it must outlive this object).
+/// controller's model). Both are kept by reference: they must outlive this object.
 template <class Kin>
 class scene_reference {
  public:
-  scene_reference(reference_spec spec, const Kin& kin, int body, const vec3<double>& point)
-      : spec_(std::move(spec)), kin_(&kin), body_(body), point_(point) {}
+  scene_reference(const reference_spec& spec, const Kin& kin, int body, const vec3<double>& point)
+      : spec_(&spec), kin_(&kin), body_(body), point_(point) {}
+  scene_reference(reference_spec&&, const Kin&, int, const vec3<double>&) = delete;  // would dangle
 
   template <class T>
   task_reference<T> operator()(const T& t) const {
-    if (const auto* j = std::get_if<joint_spline_reference>(&spec_)) {
+    if (const auto* j = std::get_if<joint_spline_reference>(spec_)) {
       task_reference<T> ref;
       j->spline(t, ref.q, ref.qd, ref.qdd);
       return with_task_image(std::move(ref));
@@ -205,7 +206,7 @@ class scene_reference {
           if constexpr (std::is_same_v<std::decay_t<decltype(r)>, joint_spline_reference>) return {};
           else return r(t);
         },
-        spec_);
+        *spec_);
   }
 
  private:
@@ -217,7 +218,7 @@ class scene_reference {
     ref.rdd = J.template topRows<3>() * ref.qdd + kin_->jdot_qdot(ref.q, ref.qd, body_, point_).linear;
     return ref;
   }
-  reference_spec spec_;
+  const reference_spec* spec_;
   const Kin* kin_;
   int body_;
   vec3<double> point_;

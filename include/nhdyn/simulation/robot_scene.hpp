@@ -98,77 +98,127 @@ inline io::robot_model load_scene_robot(const std::string& robot) {
   return r;
 }
 
-/// One run of a scene on its robot (see the file comment). Throws for a scene that cannot be
-/// set up (unknown frame or joint, wrong sizes, a controller that does not fit its
-/// reference). A function object, as `simulate`: the closed loops (one per constraint type)
-/// are compiled only where it is called.
+namespace detail {
+/// A scene's robot set up as trees (see the file comment): plant and nominal model, the
+/// constraint of each (none: holonomic), the task body (1-based) and point, the initial
+/// state, the posture mask and η's names. paper5 here is `as_tree` of its chains.
+struct scene_setup {
+  std::string robot;
+  tree<double> plant, nominal;
+  std::optional<io::robot_constraint> c_plant, c_model;
+  int body = 0;
+  vec3<double> point = vec3<double>::Zero();
+  Eigen::VectorXd q0, eta0, mask;
+  std::vector<std::string> eta_names;
+};
+
+inline scene_setup setup_scene(const run_spec& s) {
+  const std::string where = "scene '" + s.name + "': ";
+  scene_setup out;
+  if (s.robot == "paper5") {
+    detail::check_reference(s, 5);
+    const differential_drive<double> c = *io::preset<double>("paper5").constraint;
+    out.robot = "paper5";
+    out.plant = as_tree(presets::paper5<double>(s.plant).chain);
+    out.nominal = as_tree(presets::paper5<double>(s.model).chain);
+    out.c_plant = out.c_model = c;
+    out.body = 5;
+    out.q0 = s.q0, out.eta0 = s.eta0, out.mask = s.posture_mask;
+    out.eta_names = c.eta_names(out.plant.joint_names());
+    return out;
+  }
+  const io::robot_model r = load_scene_robot(s.robot);
+  const int n = r.model.dof(), m = n - r.k();
+  out.robot = r.name;
+  detail::check_reference(s, n);
+  out.plant = with_mass_factors(with_length_factors(r.model, s.plant_length, where + "plant: "), s.plant_mass, where + "plant: ");
+  out.nominal = with_mass_factors(with_length_factors(r.model, s.model_length, where + "model: "), s.model_mass, where + "model: ");
+  const auto f = r.model.find_frame(s.task_frame);  // throws naming the frame and the known ones
+  out.point = f.R * s.task_point + f.p;
+  out.body = f.body + 1;
+  if (out.body < 1) throw input_error(where + "field 'task.frame': '" + s.task_frame + "' is fixed to the world; name a moving body");
+  const auto sized = [&](const Eigen::VectorXd& v, int size, const char* what) {
+    if (v.size() == 0) return Eigen::VectorXd(Eigen::VectorXd::Zero(size));
+    if (v.size() != size)
+      throw input_error(where + "field 'initial." + what + "' has " + std::to_string(v.size()) + " entries, robot '" + r.name +
+                        "' needs " + std::to_string(size));
+    return v;
+  };
+  out.q0 = sized(s.q_start, n, "q"), out.eta0 = sized(s.eta_start, m, "eta");
+  out.mask = Eigen::VectorXd::Zero(n);
+  const auto joints = r.model.joint_names();
+  for (const auto& j : s.posture_joints) {
+    const auto it = std::find(joints.begin(), joints.end(), j);
+    if (it == joints.end())
+      throw input_error(where + "field 'controller.posture_joints': no joint '" + j + "' (joints: " + detail::names_of(r.model, true) + ")");
+    out.mask(it - joints.begin()) = 1;
+  }
+  out.eta_names = r.eta_names();
+  if (!r.constraint) {
+    if (s.plant_wheel_radius != 1 || s.model_wheel_radius != 1)
+      throw input_error(where + "field 'wheel_radius_factor': robot '" + r.name + "' has no constraint (no wheels)");
+    return out;
+  }
+  // The constraint of each tree (its geometry follows the link lengths), with its wheel radius.
+  const auto constraint_of = [&](const tree<double>& t, double radius_factor, const char* who) {
+    io::robot_constraint c = *io::constraint_on(r, t);
+    if (radius_factor != 1) {
+      auto* w = std::get_if<rolling_wheels<double>>(&c);
+      if (!w)
+        throw input_error(where + who + ".wheel_radius_factor: robot '" + r.name +
+                          "' has no wheel radius (its constraint is not of type 'wheels')");
+      w->radius *= radius_factor;
+    }
+    return c;
+  };
+  out.c_plant = constraint_of(out.plant, s.plant_wheel_radius, "plant");
+  out.c_model = constraint_of(out.nominal, s.model_wheel_radius, "model");
+  return out;
+}
+}  // namespace detail
+
+/// One run of a scene on its robot as a tree (paper5 included) with the controller
+/// `make(nominal, c, body, point, q0, posture_mask)` returns for the nominal tree and its
+/// constraint c (`holonomic<dynamic>` for a model without one): a user's controller in a
+/// scene's set-up. Throws for a scene that cannot be set up.
+template <class Make>
+run_result simulate_scene_with(const run_spec& s, const Make& make) {
+  return detail::timed([&] {  // the times include loading the robot
+    const detail::scene_setup S = detail::setup_scene(s);
+    const tree_kinematics<double> model_kin(S.nominal);
+    const scene_reference ref(s.reference, model_kin, S.body, S.point);
+    const auto run = [&](const auto& c_plant, const auto& c_model) {
+      const auto ctrl = make(S.nominal, c_model, S.body, S.point, S.q0, S.mask);
+      return simulate_robot(s.name, S.plant, c_plant, S.body, S.point, ctrl, ref, S.q0, S.eta0, options_of(s), S.eta_names);
+    };
+    if (!S.c_plant) return run(holonomic<dynamic>{S.plant.dof()}, holonomic<dynamic>{S.plant.dof()});
+    return std::visit([&](const auto& c) { return run(c, std::get<std::decay_t<decltype(c)>>(*S.c_model)); }, *S.c_plant);
+  });
+}
+
+/// The controller a scene names (controller.type) for the nominal tree and constraint c.
+struct scene_controller {
+  const run_spec& s;
+  template <class C>
+  any_controller<double, dynamic, C, tree<double>> operator()(const tree<double>& nominal, const C& c, int body,
+                                                             const vec3<double>& point, const Eigen::VectorXd& q0,
+                                                             const Eigen::VectorXd& mask) const {
+    using Ctrl = any_controller<double, dynamic, C, tree<double>>;
+    if (s.controller == controller_type::task_space) return Ctrl(rac_controller(nominal, c, s.gains, q0, mask, body, point));
+    return Ctrl(computed_torque_controller(nominal, c, s.ct));
+  }
+};
+
+/// One run of a scene on its robot (see the file comment): paper5 by `simulate` (DH kernels,
+/// fixed sizes), any other robot by simulate_scene_with and the scene's controller. Throws
+/// for a scene that cannot be set up (unknown frame or joint, wrong sizes, a controller that
+/// does not fit its reference). A function object, as `simulate`: the closed loops (one per
+/// constraint type) are compiled only where it is called.
 struct simulate_scene_fn {
   template <std::same_as<run_spec> Spec>
   run_result operator()(const Spec& s) const {
     if (s.robot == "paper5") return simulate(s);
-    return detail::timed([&] {  // the times include loading the robot
-      const std::string where = "scene '" + s.name + "': ";
-      const io::robot_model r = load_scene_robot(s.robot);
-      const int n = r.model.dof(), m = n - r.k();
-      detail::check_reference(s, n);
-      const tree<double> plant = with_mass_factors(with_length_factors(r.model, s.plant_length, where + "plant: "),
-                                                   s.plant_mass, where + "plant: ");
-      const tree<double> nominal = with_mass_factors(with_length_factors(r.model, s.model_length, where + "model: "),
-                                                     s.model_mass, where + "model: ");
-      const auto f = r.model.find_frame(s.task_frame);  // throws naming the frame and the known ones
-      const vec3<double> point = f.R * s.task_point + f.p;
-      const int body = f.body + 1;
-      if (body < 1)
-        throw input_error(where + "field 'task.frame': '" + s.task_frame + "' is fixed to the world; name a moving body");
-      const auto sized = [&](const Eigen::VectorXd& v, int size, const char* what) {
-        if (v.size() == 0) return Eigen::VectorXd(Eigen::VectorXd::Zero(size));
-        if (v.size() != size)
-          throw input_error(where + "field 'initial." + what + "' has " + std::to_string(v.size()) + " entries, robot '" +
-                            r.name + "' needs " + std::to_string(size));
-        return v;
-      };
-      const Eigen::VectorXd q0 = sized(s.q_start, n, "q"), eta0 = sized(s.eta_start, m, "eta");
-      Eigen::VectorXd mask = Eigen::VectorXd::Zero(n);
-      const auto joints = r.model.joint_names();
-      for (const auto& j : s.posture_joints) {
-        const auto it = std::find(joints.begin(), joints.end(), j);
-        if (it == joints.end())
-          throw input_error(where + "field 'controller.posture_joints': no joint '" + j + "' (joints: " +
-                            detail::names_of(r.model, true) + ")");
-        mask(it - joints.begin()) = 1;
-      }
-      const tree_kinematics<double> model_kin(nominal);
-      const scene_reference ref(s.reference, model_kin, body, point);
-      const auto run = [&](const auto& c_plant, const auto& c_model) {
-        using C = std::decay_t<decltype(c_plant)>;
-        using Ctrl = any_controller<double, dynamic, C, tree<double>>;
-        const Ctrl ctrl = s.controller == controller_type::task_space
-                              ? Ctrl(rac_controller(nominal, c_model, s.gains, q0, mask, body, point))
-                              : Ctrl(computed_torque_controller(nominal, c_model, s.ct));
-        return simulate_robot(s.name, plant, c_plant, body, point, ctrl, ref, q0, eta0, options_of(s), r.eta_names());
-      };
-      if (!r.constraint) {
-        if (s.plant_wheel_radius != 1 || s.model_wheel_radius != 1)
-          throw input_error(where + "field 'wheel_radius_factor': robot '" + r.name + "' has no constraint (no wheels)");
-        return run(holonomic<dynamic>{n}, holonomic<dynamic>{n});
-      }
-      // The constraint of each tree (its geometry follows the link lengths), with its wheel radius.
-      const auto constraint_of = [&](const tree<double>& t, double radius_factor, const char* who) {
-        io::robot_constraint c = *io::constraint_on(r, t);
-        if (radius_factor != 1) {
-          auto* w = std::get_if<rolling_wheels<double>>(&c);
-          if (!w)
-            throw input_error(where + who + ".wheel_radius_factor: robot '" + r.name +
-                              "' has no wheel radius (its constraint is not of type 'wheels')");
-          w->radius *= radius_factor;
-        }
-        return c;
-      };
-      const io::robot_constraint c_model = constraint_of(nominal, s.model_wheel_radius, "model");
-      return std::visit(
-          [&](const auto& c_plant) { return run(c_plant, std::get<std::decay_t<decltype(c_plant)>>(c_model)); },
-          constraint_of(plant, s.plant_wheel_radius, "plant"));
-    });
+    return simulate_scene_with(s, scene_controller{s});
   }
 };
 inline constexpr simulate_scene_fn simulate_scene{};
