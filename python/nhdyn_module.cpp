@@ -436,7 +436,7 @@ nhdyn::scene::search_path scene_dirs(const std::string& module_file) {
 /// joint-space reference). Called with the GIL held; a Python exception becomes the run's
 /// failure (its message), never escapes into the integrator as a Python object.
 struct python_controller {
-  py::object f;
+  py::handle f;  // no reference counting: copied and destroyed without the GIL; the caller's object outlives the runs
   int m = 0;
   template <class T>
   Eigen::Matrix<T, Eigen::Dynamic, 1> operator()(const Eigen::Matrix<T, Eigen::Dynamic, 1>& q,

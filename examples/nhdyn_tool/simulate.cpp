@@ -50,7 +50,8 @@ constexpr std::string_view usage = R"(nhdyn simulate SCENE... --out DIR [--threa
     DIR/<group>-path.png, -error.png, -q.png, -tau.png   figs. 4-6 and tau(t) (gnuplot; one
                         set per scene or study, each run one colour, named in the legend;
                         from 21 runs on: percentile bands per output time instead, min-max,
-                        5-95 % and the median, over the runs that reached the end, from
+                        5-95 % and the median, over the runs that reached the end (a failing
+                        run stops early), and 40 runs' paths, from
                         DIR/<group>-bands.csv: t, then <column>_min,_p5,_p50,_p95,_max)
   A study's runs go in parallel on --threads workers (default: all cores), with a progress
   bar and an ETA when stderr is a terminal. Under MPI (mpirun -n N nhdyn simulate ...) the
@@ -154,74 +155,97 @@ std::string gnuplot_program(const std::filesystem::path& dir, const group& g, co
   return p.str();
 }
 
-/// Groups of more runs than this get percentile bands instead of one line per run.
+/// Groups of this many runs or more get percentile bands instead of one line per run.
 constexpr std::size_t band_from = 21;
 
-/// The numbers of a CSV written by write_csv (header skipped), one row per line; empty if the
-/// file is not there or not such a CSV.
-std::vector<std::vector<double>> read_rows(const std::filesystem::path& file) {
-  std::vector<std::vector<double>> rows;
+/// Columns [c0, c1) of a CSV written by write_csv (header skipped), row after row in one
+/// buffer; `rows` gets the number of rows. Empty if the file is not there or not such a CSV.
+std::vector<double> read_columns(const std::filesystem::path& file, std::size_t c0, std::size_t c1, std::size_t& rows) {
+  std::vector<double> out;
+  rows = 0;
   std::ifstream in(file);
   std::string line;
-  if (!std::getline(in, line)) return rows;
+  if (!std::getline(in, line)) return out;
   while (std::getline(in, line)) {
-    std::vector<double> row;
     const char* c = line.data();
     const char* const end = line.data() + line.size();
-    while (c < end) {
+    std::size_t j = 0;
+    for (; c < end; ++j) {
       double x = 0;
       const auto [next, ec] = std::from_chars(c, end, x);
       if (ec != std::errc() || (next < end && *next != ',')) return {};
-      row.push_back(x);
+      if (j >= c0 && j < c1) out.push_back(x);
       c = next < end ? next + 1 : next;
     }
-    rows.push_back(std::move(row));
+    if (j < c1) return {};
+    ++rows;
   }
-  return rows;
+  return out;
 }
 
 /// DIR/<group>-bands.csv: per output time, the min, p5, p50, p95 and max of every column over
-/// the group's runs that reached the last output time (read back from their CSVs: under MPI
-/// each was written where it ran, so this needs them in one folder). Returns how many runs
-/// it used; 0 when no run had rows.
+/// the group's runs with the most output rows — those that reached the end (a failing run
+/// stops early and is left out). Read back from the runs' CSVs (under MPI each was written
+/// where it ran, so this needs them in one folder), a block of columns at a time (≤ 2^25
+/// numbers in memory: 1000 runs of 2001 rows take 63 columns in 4 passes). Returns how many
+/// runs it used; 0 when no run had rows.
 std::size_t write_bands(const std::filesystem::path& dir, const group& g, const std::vector<std::string>& names,
                         const std::vector<std::string>& columns) {
-  std::vector<std::vector<std::vector<double>>> runs;
-  std::size_t longest = 0;
-  for (auto i : g.runs) {
-    auto rows = read_rows(dir / (names[i] + ".csv"));
-    longest = std::max(longest, rows.size());
-    runs.push_back(std::move(rows));
+  std::vector<std::size_t> rows_of(g.runs.size());
+  for (std::size_t r = 0; r < g.runs.size(); ++r) read_columns(dir / (names[g.runs[r]] + ".csv"), 0, 1, rows_of[r]);
+  const std::size_t longest = rows_of.empty() ? 0 : *std::max_element(rows_of.begin(), rows_of.end());
+  std::vector<std::size_t> used;
+  for (std::size_t r = 0; r < g.runs.size(); ++r)
+    if (longest > 0 && rows_of[r] == longest) used.push_back(g.runs[r]);
+  if (used.empty()) return 0;
+  const std::size_t ncol = columns.size();
+  const std::size_t block = std::max<std::size_t>(1, (std::size_t(1) << 25) / (used.size() * longest));
+  // bands[k][5 (j − 1) + q]: row k, column j ≥ 1, statistic q (min, p5, p50, p95, max)
+  std::vector<std::vector<double>> bands(longest, std::vector<double>(5 * (ncol - 1)));
+  std::vector<double> t(longest);
+  std::vector<double> v;
+  for (std::size_t c0 = 0; c0 < ncol; c0 += block) {
+    const std::size_t c1 = std::min(ncol, c0 + block), w = c1 - c0;
+    std::vector<std::vector<double>> data;  // per run: longest × w
+    for (auto i : used) {
+      std::size_t rows = 0;
+      data.push_back(read_columns(dir / (names[i] + ".csv"), c0, c1, rows));
+      if (rows != longest) return 0;  // changed under us
+    }
+    for (std::size_t k = 0; k < longest; ++k)
+      for (std::size_t j = c0; j < c1; ++j) {
+        if (j == 0) {
+          t[k] = data[0][k * w];
+          continue;
+        }
+        v.clear();
+        for (const auto& d : data)
+          if (std::isfinite(d[k * w + (j - c0)])) v.push_back(d[k * w + (j - c0)]);
+        double* b = &bands[k][5 * (j - 1)];
+        if (v.empty()) {
+          std::fill(b, b + 5, NAN);
+          continue;
+        }
+        std::sort(v.begin(), v.end());
+        const auto at = [&](double f) {  // linear interpolation between order statistics (as summary.json)
+          const double x = f * double(v.size() - 1);
+          const std::size_t i = std::size_t(x);
+          return i + 1 < v.size() ? v[i] + (x - double(i)) * (v[i + 1] - v[i]) : v[i];
+        };
+        b[0] = v.front(), b[1] = at(0.05), b[2] = at(0.5), b[3] = at(0.95), b[4] = v.back();
+      }
   }
-  std::erase_if(runs, [&](const auto& r) { return r.size() != longest || longest == 0; });
-  if (runs.empty()) return 0;
   std::ofstream out(dir / (g.name + "-bands.csv"));
   out << "t";
-  for (std::size_t j = 1; j < columns.size(); ++j)
+  for (std::size_t j = 1; j < ncol; ++j)
     for (const char* q : {"_min", "_p5", "_p50", "_p95", "_max"}) out << ',' << columns[j] << q;
   out << '\n' << std::setprecision(9);
-  std::vector<double> v;
   for (std::size_t k = 0; k < longest; ++k) {
-    out << runs[0][k][0];
-    for (std::size_t j = 1; j < columns.size(); ++j) {
-      v.clear();
-      for (const auto& r : runs)
-        if (j < r[k].size() && std::isfinite(r[k][j])) v.push_back(r[k][j]);
-      if (v.empty()) {
-        out << ",nan,nan,nan,nan,nan";
-        continue;
-      }
-      std::sort(v.begin(), v.end());
-      const auto at = [&](double f) {  // linear interpolation between order statistics (as summary.json)
-        const double x = f * double(v.size() - 1);
-        const std::size_t i = std::size_t(x);
-        return i + 1 < v.size() ? v[i] + (x - double(i)) * (v[i + 1] - v[i]) : v[i];
-      };
-      out << ',' << v.front() << ',' << at(0.05) << ',' << at(0.5) << ',' << at(0.95) << ',' << v.back();
-    }
+    out << t[k];
+    for (double x : bands[k]) out << ',' << x;
     out << '\n';
   }
-  return runs.size();
+  return used.size();
 }
 
 /// gnuplot program for a group of many runs: the same four figures, each column as bands
@@ -463,17 +487,51 @@ int run(const std::vector<std::string>& args) {
     r.cpu_time_s += nhdyn::detail::thread_cpu_seconds() - cpu0;
     r.rows.resize(0, 0);  // written; free the memory
   };
+  // The bar counts finished runs and, within the runs this process is running, their
+  // simulated time (run_options::progress), so a long single run moves it too.
+  std::vector<std::atomic<double>> partial(specs.size());  // fraction of run i simulated
+  std::vector<char> finished(specs.size(), 0);
+  std::string last_name;
+  if (tty)
+    for (std::size_t i = 0; i < specs.size(); ++i)
+      specs[i].progress = [&partial, i, d = specs[i].duration](double t) {
+        partial[i].store(std::min(1.0, t / d), std::memory_order_relaxed);
+      };
+  const auto draw = [&] {  // rank 0, under m
+    double sum = 0;
+    for (std::size_t i = 0; i < specs.size(); ++i) sum += finished[i] ? 1.0 : partial[i].load(std::memory_order_relaxed);
+    const double f = sum / double(specs.size());
+    const int width = 30, filled = int(double(width) * f);
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::cerr << "\r[" << std::string(std::size_t(filled), '#') << std::string(std::size_t(width - filled), ' ') << "] "
+              << done << "/" << specs.size() << "  " << fixed(elapsed, 0) << " s, ETA "
+              << (f > 0 ? fixed(elapsed * (1 - f) / f, 0) + " s" : std::string("?")) << "  " << last_name << "\033[K"
+              << std::flush;
+  };
   const auto progress = [&](std::size_t i) {  // rank 0, under m
     ++done;
-    if (tty) {
-      const int width = 30, filled = int(double(width) * double(done) / double(specs.size()));
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      const double eta = elapsed / double(done) * double(specs.size() - done);
-      std::cerr << "\r[" << std::string(std::size_t(filled), '#') << std::string(std::size_t(width - filled), ' ')
-                << "] " << done << "/" << specs.size() << "  " << fixed(elapsed, 0) << " s, ETA " << fixed(eta, 0) << " s  "
-                << specs[i].name << "\033[K" << std::flush;
-    }
+    finished[i] = 1;
+    last_name = specs[i].name;
+    if (tty) draw();
   };
+  std::atomic<bool> all_done{false};
+  std::thread ticker;  // redraws the bar between finished runs
+  struct stop_ticker {  // joined on every way out (an exception included)
+    std::atomic<bool>& done;
+    std::thread& t;
+    ~stop_ticker() {
+      done = true;
+      if (t.joinable()) t.join();
+    }
+  } stop{all_done, ticker};
+  if (tty)
+    ticker = std::thread([&] {
+      while (!all_done.load()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(250));
+        const std::lock_guard<std::mutex> lock(m);
+        if (!all_done.load()) draw();
+      }
+    });
   std::vector<nhdyn::run_result> results;
   std::vector<int> ranks(specs.size(), 0);
   if (mpi.size == 1) {
@@ -558,6 +616,8 @@ int run(const std::vector<std::string>& args) {
     }
   }
 #endif
+  all_done = true;
+  if (ticker.joinable()) ticker.join();
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (tty) std::cerr << "\r\033[K" << std::flush;
 

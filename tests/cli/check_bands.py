@@ -39,6 +39,21 @@ def main():
         worst = max(worst, float(np.max(np.abs(got - want) / np.maximum(scale, 1e-12))))
         assert np.all(np.diff(got, axis=1) >= -1e-12 * scale[:, 1:]), f"{name}: bands out of order"
     assert worst < 1e-8, f"bands differ from NumPy's percentiles by {worst:.3g} (relative)"
+    # the figure script reads the columns it names: every band is a (_min, _max) or
+    # (_p5, _p95) pair of one column, every median line a _p50, the error figure err's
+    import re
+    script = open(os.path.join(out, group + ".gp")).read()
+    pairs = re.findall(r"using 1:(\d+):(\d+) with filledcurves", script)
+    medians = re.findall(r"using 1:(\d+) with lines lw 2", script)
+    assert pairs and len(medians) * 2 == len(pairs), (len(pairs), len(medians))
+    for a, b in pairs:
+        lo, hi = head[int(a) - 1], head[int(b) - 1]
+        assert (lo.endswith("_min") and hi == lo[:-4] + "_max") or (lo.endswith("_p5") and hi == lo[:-3] + "_p95"), (lo, hi)
+    for c in medians:
+        assert head[int(c) - 1].endswith("_p50"), head[int(c) - 1]
+    error_plot = script[script.index("-error.png"):]
+    first = re.search(r"using 1:(\d+):(\d+) with filledcurves", error_plot)
+    assert head[int(first.group(1)) - 1] == "err_min", head[int(first.group(1)) - 1]
     if "--figures" in sys.argv:
         for fig in ("path", "error", "q", "tau"):
             p = os.path.join(out, f"{group}-{fig}.png")

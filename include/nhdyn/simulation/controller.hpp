@@ -1,6 +1,8 @@
 #pragma once
 /// \file simulation/controller.hpp
-/// The paper's robust task-space controller (paper.md §3, Salazar-Silva et al. §V) for a
+/// Controllers of the closed loop: the joint-space computed-torque controller (below, with
+/// its equations), `any_controller` (either behind one call), and the paper's robust
+/// task-space controller (paper.md §3, Salazar-Silva et al. §V) for a
 /// point r ∈ R³ on any body of any model (a DH chain or a kinematic tree) with any
 /// constraint; paper5.md uses it with r the origin of paper5's last link:
 ///
@@ -196,7 +198,7 @@ struct ct_gains {
 ///
 ///     q̇ = S η,   a_q = q̈_d + k_D (q̇_d − q̇) + k_P (q_d − q)
 ///     η̇* = (SᵀS)⁻¹ Sᵀ (a_q − Ṡ η)        (the admissible η̇ nearest to a_q, least squares)
-///     τ  = (SᵀS)⁻¹ Sᵀ rne_nominal(q, Sη, Sη̇* + Ṡη)                      (eq. 21)
+///     τ  = (SᵀE)⁻¹ Sᵀ rne_nominal(q, Sη, Sη̇* + Ṡη)   (eq. 21; E = S without an input map)
 ///
 /// Without a constraint (S = I) this is τ = M(q) a_q + h(q, q̇), and on the nominal plant the
 /// error obeys ë + k_D ė + k_P e = 0. With a constraint only the part of the error that the

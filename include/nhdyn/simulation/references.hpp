@@ -16,6 +16,7 @@
 /// `reference_spec` is a scene's reference as data; `scene_reference(spec, kinematics, body,
 /// point)` is the callable the closed loop evaluates.
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <variant>
 #include <vector>
@@ -85,7 +86,8 @@ struct line_reference {
 };
 
 /// The cubic spline through (t_k, y_k), k = 0…K (y_k ∈ R^d, one row each), with zero
-/// velocity at t₀ and t_K ("clamped"): C² inside, y(t) = y₀ before t₀ and y_K after t_K.
+/// velocity at t₀ and t_K ("clamped"): C² inside, y(t) = y₀ before t₀ and y_K after t_K
+/// (continuous in y and y' there; y'' steps from 0 to M₀ at t₀ and from M_K to 0 at t_K).
 /// With h_k = t_{k+1} − t_k and M_k = y''(t_k) (Burden & Faires, Alg. 3.5):
 ///
 ///     h_{k−1} M_{k−1} + 2(h_{k−1} + h_k) M_k + h_k M_{k+1} = 6(Δ_k − Δ_{k−1}),  Δ_k = (y_{k+1} − y_k)/h_k
@@ -191,8 +193,12 @@ template <class Kin>
 class scene_reference {
  public:
   scene_reference(const reference_spec& spec, const Kin& kin, int body, const vec3<double>& point)
-      : spec_(&spec), kin_(&kin), body_(body), point_(point) {}
+      : spec_(&spec), kin_(&kin), body_(body), point_(point) {
+    if (const auto* l = std::get_if<line_reference>(&spec); l && !(l->end > l->start))
+      throw input_error("line reference: end must be later than start");
+  }
   scene_reference(reference_spec&&, const Kin&, int, const vec3<double>&) = delete;  // would dangle
+  scene_reference(const reference_spec&, const Kin&&, int, const vec3<double>&) = delete;
 
   template <class T>
   task_reference<T> operator()(const T& t) const {

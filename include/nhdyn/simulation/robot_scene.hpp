@@ -15,7 +15,10 @@
 /// joint's placement (the joint's origin in its parent; for a DH model d and a of that link)
 /// and on the constraint's wheel radius. A model without a constraint is holonomic (S = I).
 #include <algorithm>
+#include <cctype>
 #include <concepts>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <variant>
 
@@ -58,7 +61,10 @@ inline tree<double> with_mass_factors(const tree<double>& t, const std::vector<s
 }
 
 /// t with the placements of the named joints scaled: the joint's origin in its parent (p_PJ)
-/// and the body frame's offset from the joint (p_JB; zero for URDFs, a for DH models).
+/// and the body frame's offset from the joint (p_JB; zero for URDFs, a for DH models). The
+/// body's centre of mass and inertia stay where they are in its frame (paper5's own length
+/// factors, which also move the box's mass, are another model). A joint whose placement is
+/// zero (a planar base's joints) has no length to scale: an error.
 inline tree<double> with_length_factors(const tree<double>& t, const std::vector<std::pair<std::string, double>>& factors,
                                         const std::string& where) {
   if (factors.empty()) return t;
@@ -68,6 +74,8 @@ inline tree<double> with_length_factors(const tree<double>& t, const std::vector
     if (it == B.end())
       throw input_error(where + "no movable joint named '" + name + "' for a length factor (joints: " +
                         detail::names_of(t, true) + ")");
+    if (it->p_PJ.norm() == 0 && it->p_JB.norm() == 0)
+      throw input_error(where + "joint '" + name + "' sits at its parent's origin: no placement length to scale");
     it->p_PJ *= f;
     it->p_JB *= f;
   }
@@ -81,10 +89,10 @@ inline io::robot_model load_scene_robot(const std::string& robot) {
   std::string ext = std::filesystem::path(robot).extension().string();
   for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
   if (ext == ".urdf") {
-    io::robot_model r{io::load_urdf(robot), std::nullopt, ""};
-    r.name = r.model.name();
-    r.path = robot;
-    return r;
+    tree<double> t = io::load_urdf(robot);
+    std::string name = t.name();
+    return io::robot_model{.model = std::move(t), .constraint = std::nullopt, .name = std::move(name),
+                           .constraint_source = {}, .path = robot, .planar_base = false};
   }
   const bool preset = std::find(presets.begin(), presets.end(), robot) != presets.end();
   if (!preset) {
@@ -92,9 +100,9 @@ inline io::robot_model load_scene_robot(const std::string& robot) {
     if (const auto j = nlohmann::json::parse(in, nullptr, false); j.is_object() && j.contains("urdf")) return io::load_robot_file(robot);
   }
   const io::model<double> m = io::load<double>(robot);
-  io::robot_model r{as_tree(m.chain), std::nullopt, m.chain.name()};
+  io::robot_model r{.model = as_tree(m.chain), .constraint = std::nullopt, .name = m.chain.name(),
+                    .constraint_source = {}, .path = robot, .planar_base = false};
   if (m.constraint) r.constraint = *m.constraint;
-  r.path = robot;
   return r;
 }
 
@@ -156,16 +164,23 @@ inline scene_setup setup_scene(const run_spec& s) {
   out.eta_names = r.eta_names();
   if (!r.constraint) {
     if (s.plant_wheel_radius != 1 || s.model_wheel_radius != 1)
-      throw input_error(where + "field 'wheel_radius_factor': robot '" + r.name + "' has no constraint (no wheels)");
+      throw input_error(where + "field '" + (s.plant_wheel_radius != 1 ? "plant" : "model") +
+                        ".wheel_radius_factor': robot '" + r.name + "' has no constraint (no wheels)");
     return out;
   }
   // The constraint of each tree (its geometry follows the link lengths), with its wheel radius.
-  const auto constraint_of = [&](const tree<double>& t, double radius_factor, const char* who) {
-    io::robot_constraint c = *io::constraint_on(r, t);
+  const auto constraint_of = [&](const tree<double>& t, double radius_factor, const std::string& who) {
+    io::robot_constraint c = [&] {
+      try {
+        return *io::constraint_on(r, t);
+      } catch (const std::exception& e) {  // e.g. one wheel moved off the common axle
+        throw input_error(where + who + " (its length factors): " + e.what());
+      }
+    }();
     if (radius_factor != 1) {
       auto* w = std::get_if<rolling_wheels<double>>(&c);
       if (!w)
-        throw input_error(where + who + ".wheel_radius_factor: robot '" + r.name +
+        throw input_error(where + "field '" + who + ".wheel_radius_factor': robot '" + r.name +
                           "' has no wheel radius (its constraint is not of type 'wheels')");
       w->radius *= radius_factor;
     }

@@ -272,10 +272,11 @@ inline run_spec parse_run(const json& j, const std::vector<std::filesystem::path
   s.gains.robust = {rb.number("alpha", 0), rb.number("gamma0", 0), rb.number("gamma1", 0.1),
                     rb.number("gamma2", 0.2), rb.number("epsilon", 0)};
 
-  const std::string rtype = o.has("reference") && o.j.at("reference").is_object() && o.j.at("reference").contains("type") &&
-                                  o.j.at("reference").at("type").is_string()
-                              ? o.j.at("reference").at("type").get<std::string>()
-                              : "circle";
+  const std::string rtype = o.has("reference") && o.j.at("reference").is_object()
+                                ? o.sub("reference", {"type", "center", "u", "v", "radius", "period", "phase", "from", "to",
+                                                      "start", "end", "times", "points", "q"})
+                                      .text("type", "circle")
+                                : "circle";
   if (rtype == "circle") {
     const auto r = o.sub("reference", {"type", "center", "u", "v", "radius", "period", "phase"});
     circle_reference cr;

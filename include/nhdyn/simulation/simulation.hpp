@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <ctime>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
 
@@ -43,6 +44,11 @@ struct run_options {
   double noise_sigma = 0;  ///< m, per coordinate of the measured r, per sample
   std::uint64_t seed = 1;
   double tail_from = 15, tail_tolerance = 0.01;  ///< success: max ‖r̃‖ over [tail_from, end] below this
+  /// Called with the simulated time at every output row, from the simulating thread (a
+  /// progress display for long runs); empty: not called. Under run_batch a callback shared
+  /// by several specs is called from several threads at once; an exception it throws fails
+  /// the run.
+  std::function<void(double)> progress{};
 };
 
 /// Which controller a scene runs (controller.hpp).
@@ -227,6 +233,7 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
     row << t, x.transpose(), tau.transpose(), r.transpose(), rd.transpose(), (rd - r).norm();
     res.peak_tau = std::max(res.peak_tau, tau.cwiseAbs().maxCoeff());
     rows_done = i + 1;
+    if (s.progress) s.progress(t);
   };
 
   vecN<double, D> x(n + m);
@@ -333,7 +340,7 @@ struct simulate_fn {
     return detail::timed([&] {
       if (s.robot != "paper5")
         throw input_error("scene '" + s.name + "': robot '" + s.robot +
-                          "' is a robot file: simulate_scene (simulation/robot_scene.hpp, needs URDF support) runs it");
+                          "' is not paper5: simulate_scene (simulation/robot_scene.hpp, needs URDF support) runs it");
       detail::check_reference(s, 5);
       const auto plant = presets::paper5<double>(s.plant);
       const auto nominal = presets::paper5<double>(s.model);
