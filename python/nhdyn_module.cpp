@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <span>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -125,11 +126,12 @@ struct output {
 /// (row-major for a matrix).
 class batch_function {
  public:
-  using kernel = std::function<void(const std::vector<const double*>&, const std::vector<double*>&)>;
+  using kernel = std::function<void(std::span<const double* const>, std::span<double* const>)>;
   batch_function(std::string name, std::vector<std::pair<std::string, int>> args, std::vector<output> outs, kernel f)
       : name_(std::move(name)), args_(std::move(args)), outs_(std::move(outs)), f_(std::move(f)) {}
 
   py::object call(const py::args& a, int threads) const {
+    if (auto fast = call_one(a, threads)) return std::move(*fast);
     if (a.size() != args_.size()) {
       std::string want;
       for (const auto& x : args_) want += (want.empty() ? "" : ", ") + x.first;
@@ -191,9 +193,40 @@ class batch_function {
   }
 
  private:
+  /// The common case at the least cost: one state of float64, C-contiguous 1-D arrays of the
+  /// right sizes — no conversions, no heap bookkeeping beyond the result arrays (the
+  /// single-call overhead, docs/python.md). Anything else (batches, other dtypes, wrong
+  /// sizes and their messages): empty, and `call` takes the general path.
+  std::optional<py::object> call_one(const py::args& a, int threads) const {
+    constexpr std::size_t max_args = 8, max_outs = 4;
+    const std::size_t k = a.size();
+    if (threads > 1 || k != args_.size() || k > max_args || outs_.size() > max_outs) return std::nullopt;
+    std::array<const double*, max_args> ip{};
+    for (std::size_t j = 0; j < k; ++j) {
+      const py::handle h = PyTuple_GET_ITEM(a.ptr(), py::ssize_t(j));
+      if (!py::array_t<double, py::array::c_style>::check_(h)) return std::nullopt;
+      const auto& arr = reinterpret_cast<const py::array&>(h);  // a borrowed array: no reference taken
+      if (arr.ndim() != 1 || arr.shape(0) != args_[j].second) return std::nullopt;
+      ip[j] = static_cast<const double*>(arr.data());
+    }
+    std::array<py::object, max_outs> out;
+    std::array<double*, max_outs> op{};
+    for (std::size_t o = 0; o < outs_.size(); ++o) {
+      py::array_t<double> x = outs_[o].cols ? py::array_t<double>({py::ssize_t(outs_[o].rows), py::ssize_t(outs_[o].cols)})
+                                            : py::array_t<double>(py::ssize_t(outs_[o].rows));
+      op[o] = x.mutable_data();
+      out[o] = std::move(x);
+    }
+    f_(std::span<const double* const>(ip.data(), k), std::span<double* const>(op.data(), outs_.size()));
+    if (outs_.size() == 1) return std::move(out[0]);
+    py::tuple t(outs_.size());
+    for (std::size_t o = 0; o < outs_.size(); ++o) t[o] = std::move(out[o]);
+    return py::object(std::move(t));
+  }
+
   /// Rows [0, count): with the GIL released, on `threads` threads (≤ 1: this one). The first
   /// error (by row) is rethrown, naming the row for a batch.
-  void run(const std::vector<const double*>& in, const std::vector<double*>& out, py::ssize_t count, int threads) const {
+  void run(std::span<const double* const> in, std::span<double* const> out, py::ssize_t count, int threads) const {
     const bool batch = count > 1 || threads > 1;
     if (!batch) {  // one state: no GIL hand-over, no bookkeeping (the call's overhead, docs/python.md)
       f_(in, out);
@@ -313,6 +346,103 @@ batch_function nh_fd_of(const Model& mdl, const C& c) {
   const auto f = nhdyn::nh_forward_dynamics(mdl, c);
   return {"forward_dynamics", {{"q", n}, {"eta", m}, {"tau", m}}, {{"eta_dot", m}}, [f, n, m](const auto& in, const auto& out) {
             vmap(out[0], m) = f(cmap(in[0], n), cmap(in[1], m), cmap(in[2], m));
+          }};
+}
+
+
+// ---------------------------------------------------------------------------------------
+// Drives and contacts: friction stages and external wrenches (docs/api.md §3a)
+// ---------------------------------------------------------------------------------------
+
+/// Wrenches from Python: a list of dicts {"body": name, "frame": "world" | "body", "point",
+/// "force", "moment"} (3 numbers each; zeros by default), as the tool's "f_ext".
+template <class Model>
+std::vector<nhdyn::wrench<double>> wrenches_from(const Model& mdl, const py::list& list) {
+  std::vector<nhdyn::wrench<double>> out;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const std::string w = "wrenches[" + std::to_string(k) + "]";
+    if (!py::isinstance<py::dict>(list[k])) throw nhdyn::input_error(w + ": a dict {\"body\", \"force\", ...}");
+    const auto d = list[k].cast<py::dict>();
+    for (const auto& [key, value] : d) {
+      const std::string k2 = py::str(key);
+      if (k2 != "body" && k2 != "frame" && k2 != "point" && k2 != "force" && k2 != "moment")
+        throw nhdyn::input_error(w + ": unknown key '" + k2 + "' (known: body, frame, point, force, moment)");
+    }
+    if (!d.contains("body") || !py::isinstance<py::str>(d["body"])) throw nhdyn::input_error(w + ": 'body' (a body name) is missing");
+    nhdyn::wrench_frame frame = nhdyn::wrench_frame::world;
+    if (d.contains("frame")) {
+      const std::string f = py::str(d["frame"]);
+      if (f == "body") frame = nhdyn::wrench_frame::body;
+      else if (f != "world") throw nhdyn::input_error(w + ": 'frame' must be \"world\" or \"body\"");
+    }
+    const auto v3 = [&](const char* key) {
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      if (!d.contains(key)) return v;
+      const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(d[key]);
+      if (!a || a.ndim() != 1 || a.shape(0) != 3) throw nhdyn::input_error(w + "." + key + ": 3 numbers");
+      for (int r = 0; r < 3; ++r) {
+        v(r) = a.at(r);
+        if (!std::isfinite(v(r))) throw nhdyn::input_error(w + "." + key + ": not finite");
+      }
+      return v;
+    };
+    out.push_back(nhdyn::wrench_on(mdl, d["body"].cast<std::string>(), frame, v3("point"), v3("force"), v3("moment")));
+  }
+  return out;
+}
+
+template <class Model>
+batch_function rne_wrenches_of(const Model& mdl, const py::list& w) {
+  const int n = mdl.dof();
+  const auto f = nhdyn::rne(mdl);
+  const auto fx = nhdyn::external_wrenches(mdl, wrenches_from(mdl, w));
+  return {"rne", {{"q", n}, {"qd", n}, {"qdd", n}}, {{"tau", n}}, [f, fx, n](const auto& in, const auto& out) {
+            vmap(out[0], n) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], n)), VectorXd(cmap(in[2], n)), fx);
+          }};
+}
+template <class Model, class C>
+batch_function nh_id_wrenches_of(const Model& mdl, const C& c, const py::list& w) {
+  const int n = mdl.dof(), m = c.m();
+  const auto fx = nhdyn::external_wrenches(mdl, wrenches_from(mdl, w));
+  const auto f = nhdyn::lift(c) | nhdyn::rne(mdl) | fx | nhdyn::constraint_forces(c);
+  return {"inverse_dynamics", {{"q", n}, {"eta", m}, {"eta_dot", m}}, {{"tau", m}}, [f, n, m](const auto& in, const auto& out) {
+            vmap(out[0], m) = f(nhdyn::reduced_state<double>{VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)),
+                                                             VectorXd(cmap(in[2], m))}).tau;
+          }};
+}
+template <class Model>
+batch_function holonomic_fd_wrenches_of(const Model& mdl, const py::list& w) {
+  const int n = mdl.dof();
+  const auto f = nhdyn::forward_dynamics(mdl);
+  const auto fx = nhdyn::external_wrenches(mdl, wrenches_from(mdl, w));
+  return {"forward_dynamics", {{"q", n}, {"qd", n}, {"tau", n}}, {{"qdd", n}}, [f, fx, n](const auto& in, const auto& out) {
+            vmap(out[0], n) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], n)), VectorXd(cmap(in[2], n)), fx);
+          }};
+}
+template <class Model, class C>
+batch_function nh_fd_wrenches_of(const Model& mdl, const C& c, const py::list& w) {
+  const int n = mdl.dof(), m = c.m();
+  const auto f = nhdyn::nh_forward_dynamics(mdl, c);
+  const auto fx = nhdyn::external_wrenches(mdl, wrenches_from(mdl, w));
+  return {"forward_dynamics", {{"q", n}, {"eta", m}, {"tau", m}}, {{"eta_dot", m}}, [f, fx, n, m](const auto& in, const auto& out) {
+            vmap(out[0], m) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)), VectorXd(cmap(in[2], m)), fx);
+          }};
+}
+template <class Model>
+batch_function generalized_force_of(const Model& mdl, const py::list& w) {
+  const int n = mdl.dof();
+  const auto fx = nhdyn::external_wrenches(mdl, wrenches_from(mdl, w));
+  return {"generalized_force", {{"q", n}}, {{"Q", n}}, [fx, n](const auto& in, const auto& out) {
+            vmap(out[0], n) = fx.generalized_force(VectorXd(cmap(in[0], n)));
+          }};
+}
+template <class Model>
+batch_function friction_of(const Model& mdl, double smooth) {
+  const int n = mdl.dof();
+  if (!(smooth >= 0) || !std::isfinite(smooth)) throw nhdyn::input_error("friction: smooth must be a finite v_s ≥ 0 [rad/s or m/s]");
+  const auto f = smooth > 0 ? nhdyn::friction(mdl, nhdyn::coulomb_law::smooth(smooth)) : nhdyn::friction(mdl);
+  return {"friction", {{"qd", n}}, {{"tau_f", n}}, [f, n](const auto& in, const auto& out) {
+            vmap(out[0], n) = f(VectorXd(cmap(in[0], n)));
           }};
 }
 
@@ -576,25 +706,87 @@ spec: a preset name (nhdyn.presets()), a JSON model file, a URDF file (*.urdf) o
 file (JSON with a "urdf" key: a URDF on a wheeled base with its constraint). strict: a
 non-physical URDF inertia is an error instead of a warning on stderr. Raises ModelError
 with the file, link and field at fault.)");
-  mod.def("rne", [](const model& m) { return m.dispatch([](const auto& x, const auto&) { return rne_of(x); }, [](const auto& x) { return rne_of(x); }); },
-          py::arg("model"),
-          R"(rne(model) -> f(q, qd, qdd) -> tau
+  mod.def("rne", [](const model& m, const std::optional<py::list>& w) {
+            if (w) return m.dispatch([&](const auto& x, const auto&) { return rne_wrenches_of(x, *w); }, [&](const auto& x) { return rne_wrenches_of(x, *w); });
+            return m.dispatch([](const auto& x, const auto&) { return rne_of(x); }, [](const auto& x) { return rne_of(x); }); },
+          py::arg("model"), py::arg("wrenches") = py::none(),
+          R"(rne(model, wrenches=None) -> f(q, qd, qdd) -> tau
 
 The holonomic recursive Newton-Euler inverse dynamics tau = M(q) qdd + C(q, qd) qd + g(q)
 (+ armature qdd), n entries each [rad, rad/s, rad/s^2 or m, m/s, m/s^2 -> N m or N]. For a
-constrained model: of its stationary robot (all n joints).)");
+constrained model: of its stationary robot (all n joints). wrenches: external wrenches the
+environment applies, a list of {"body": name, "frame": "world" or "body", "point": [m, in
+the body frame], "force": [N], "moment": [N m]}: tau - sum J^T [f; m].)");
   mod.def("mass_matrix", [](const model& m) { return m.dispatch([](const auto& x, const auto&) { return mass_matrix_of(x); }, [](const auto& x) { return mass_matrix_of(x); }); },
           py::arg("model"), "mass_matrix(model) -> f(q) -> M (n x n, CRBA) [kg m^2, kg]");
   mod.def("bias", [](const model& m) { return m.dispatch([](const auto& x, const auto&) { return bias_of(x); }, [](const auto& x) { return bias_of(x); }); },
           py::arg("model"), "bias(model) -> f(q, qd) -> h = C(q, qd) qd + g(q) (n entries)");
   mod.def("inverse_dynamics",
-          [](const model& m) { return m.dispatch([](const auto& x, const auto& c) { return nh_id_of(x, c); }, [](const auto& x) { return rne_of(x); }); },
-          py::arg("model"),
-          R"(inverse_dynamics(model) -> f(q, eta, eta_dot) -> tau
+          [](const model& m, const std::optional<py::list>& w) {
+            if (w)
+              return m.dispatch([&](const auto& x, const auto& c) { return nh_id_wrenches_of(x, c, *w); },
+                                [&](const auto& x) { return rne_wrenches_of(x, *w); });
+            return m.dispatch([](const auto& x, const auto& c) { return nh_id_of(x, c); }, [](const auto& x) { return rne_of(x); }); },
+          py::arg("model"), py::arg("wrenches") = py::none(),
+          R"(inverse_dynamics(model, wrenches=None) -> f(q, eta, eta_dot) -> tau
 
 The paper's nonholonomic inverse dynamics, project o rne o lift: q (n), eta and eta_dot (m,
 named by model.eta) -> tau (m actuator forces). A model without a constraint: eta = qd, and
-this is rne.)");
+this is rne. wrenches: external wrenches as for rne, inside the pipeline (lift | rne |
+wrenches | project).)");
+  mod.def("friction",
+          [](const model& m, double smooth) {
+            return m.dispatch([&](const auto& x, const auto&) { return friction_of(x, smooth); }, [&](const auto& x) { return friction_of(x, smooth); });
+          },
+          py::arg("model"), py::arg("smooth") = 0.0,
+          R"(friction(model, smooth=0) -> f(qd) -> tau_f (n entries) [N m or N]
+
+The joints' friction from the model (JSON "friction"/"motor", URDF <dynamics damping
+friction>): tau_f,i = B_i qd_i + c_i(qd_i), c = c+ for qd > 0, c- for qd < 0, 0 at rest.
+smooth = v_s > 0 [rad/s or m/s]: c+ qd / sqrt(qd^2 + v_s^2) instead (continuous). What the
+drives must add to rne's torque: rne(model)(q, qd, qdd) + friction(model)(qd).)");
+  mod.def("generalized_force",
+          [](const model& m, const py::list& w) {
+            return m.dispatch([&](const auto& x, const auto&) { return generalized_force_of(x, w); },
+                              [&](const auto& x) { return generalized_force_of(x, w); });
+          },
+          py::arg("model"), py::arg("wrenches"),
+          R"(generalized_force(model, wrenches) -> f(q) -> Q (n entries)
+
+Q = sum J^T [f; m] of the external wrenches (as for rne) at q: what they add to the
+generalized forces (rne with them is rne - Q).)");
+  // The loop a C++ user writes around the library's call (rows copied into Eigen vectors,
+  // τ stored row by row), compiled in this module with its flags: the reference that
+  // bench/python_bench.py measures the batched call against, in the same process on the
+  // same arrays (issue 16: 10⁶ paper5 inverse dynamics from Python within 1.5× of it).
+  mod.def("_cxx_loop_inverse_dynamics",
+          [](const model& m, const py::array_t<double, py::array::c_style | py::array::forcecast>& Q,
+             const py::array_t<double, py::array::c_style | py::array::forcecast>& E,
+             const py::array_t<double, py::array::c_style | py::array::forcecast>& ED) {
+            const int n = m.dof(), k = m.m();
+            if (Q.ndim() != 2 || E.ndim() != 2 || ED.ndim() != 2 || Q.shape(1) != n || E.shape(1) != k || ED.shape(1) != k ||
+                E.shape(0) != Q.shape(0) || ED.shape(0) != Q.shape(0))
+              throw nhdyn::input_error("_cxx_loop_inverse_dynamics: rows of q (n), eta and eta_dot (m)");
+            const py::ssize_t rows = Q.shape(0);
+            py::array_t<double> out({rows, py::ssize_t(k)});
+            const double *q = Q.data(), *e = E.data(), *ed = ED.data();
+            double* o = out.mutable_data();
+            py::gil_scoped_release release;
+            m.dispatch(
+                [&](const auto& x, const auto& c) {
+                  const auto f = nhdyn::inverse_dynamics(x, c);
+                  VectorXd qv(n), ev(k), edv(k);
+                  for (py::ssize_t i = 0; i < rows; ++i) {
+                    qv = cmap(q + i * n, n), ev = cmap(e + i * k, k), edv = cmap(ed + i * k, k);
+                    vmap(o + i * k, k) = f(qv, ev, edv);
+                  }
+                  return 0;
+                },
+                [&](const auto&) -> int { throw nhdyn::input_error("_cxx_loop_inverse_dynamics: a constrained model"); });
+            return out;
+          },
+          py::arg("model"), py::arg("q"), py::arg("eta"), py::arg("eta_dot"),
+          "Benchmark reference (bench/python_bench.py): a plain C++ loop of the library's inverse dynamics over rows.");
   mod.def("inverse_dynamics_with_forces",
           [](const model& m) { return m.dispatch([](const auto& x, const auto& c) { return nh_id_forces_of(x, c); },
                                                   [&](const auto&) { return not_constrained(m, "inverse_dynamics_with_forces"); }); },
@@ -639,9 +831,15 @@ The geometric Jacobian of a point fixed on a body or frame (point in that frame,
 base frame: rows 0-2 the point's velocity [m/s], rows 3-5 the angular velocity [rad/s] per
 unit qd.)");
   mod.def("forward_dynamics",
-          [](const model& m) { return m.dispatch([](const auto& x, const auto& c) { return nh_fd_of(x, c); }, [](const auto& x) { return holonomic_fd_of(x); }); },
-          py::arg("model"),
-          R"(forward_dynamics(model) -> f(q, eta_or_qd, tau) -> eta_dot or qdd
+          [](const model& m, const std::optional<py::list>& w) {
+            if (w)
+              return m.dispatch([&](const auto& x, const auto& c) { return nh_fd_wrenches_of(x, c, *w); },
+                                [&](const auto& x) { return holonomic_fd_wrenches_of(x, *w); });
+            return m.dispatch([](const auto& x, const auto& c) { return nh_fd_of(x, c); }, [](const auto& x) { return holonomic_fd_of(x); }); },
+          py::arg("model"), py::arg("wrenches") = py::none(),
+          R"(forward_dynamics(model, wrenches=None) -> f(q, eta_or_qd, tau) -> eta_dot or qdd
+
+wrenches: external wrenches as for rne, acting on the robot.
 
 Constrained: eta_dot = M_eta^-1 (S^T E tau - h_eta) (m entries). Holonomic: qdd (n entries),
 by CRBA + LDL^T or ABA (chosen as the C++ forward_dynamics does). Raises NumericalError for

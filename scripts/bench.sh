@@ -47,6 +47,14 @@ compiler="$("$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt"
 "$py" "$root/scripts/perf_table.py" "$json" "$root/docs/performance.md" "$root/docs/performance_scaling.png" \
   --cpu "$cpu" --compiler "$compiler"
 
+# The Python module's call overhead and batch throughput (issue 16), when it can be built.
+if make -C "$build" -j2 nhdyn_python >/dev/null 2>&1 && [ -d "$build/python" ]; then
+  PYTHONPATH="$build/python" "$py" "$root/bench/python_bench.py" "$root/docs/performance-python.json" \
+    --doc "$root/docs/performance.md"
+else
+  echo "bench.sh: the Python module was not built (pybind11-dev, python3-dev, python3-numpy): no Python benchmark"
+fi
+
 if [ "$scalar" = 1 ]; then
   sjson="$root/docs/performance-scalar.json"
   "$build/bench/nhdyn_bench_scalar" --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true \

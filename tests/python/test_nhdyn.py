@@ -278,3 +278,67 @@ def test_a_python_controller_drives_a_scene_as_the_same_law_in_cpp_does():
     assert not short["success"] and "6 numbers" in short["failure"]
     with pytest.raises(nhdyn.InputError, match="callable"):
         nhdyn.simulate(scene, controller=3)
+
+
+def test_wrenches_and_friction_from_python():
+    rng = np.random.default_rng(5)
+    # External wrenches: rne with them = rne - J^T [f; m], the Jacobian of the same point
+    # (nhdyn.jacobian, in the world's axes) and the sign the docs state.
+    puma = nhdyn.load("puma560")
+    q, qd, qdd = (rng.uniform(-1, 1, 6) for _ in range(3))
+    point, force, moment = np.array([0.01, 0.02, 0.05]), np.array([3.0, -2.0, 5.0]), np.array([0.4, 0.1, -0.3])
+    w = [{"body": "link6", "point": point, "force": force, "moment": moment}]
+    J = nhdyn.jacobian(puma, "link6", point)(q)
+    want = nhdyn.rne(puma)(q, qd, qdd) - J[:3].T @ force - J[3:].T @ moment
+    got = nhdyn.rne(puma, wrenches=w)(q, qd, qdd)
+    assert np.max(np.abs(got - want)) < 1e-12 * max(1.0, np.max(np.abs(want)))
+    assert np.allclose(nhdyn.generalized_force(puma, w)(q), J[:3].T @ force + J[3:].T @ moment, rtol=0, atol=1e-13)
+    # body axes: the same wrench rotated into the body frame is the same physics
+    R = nhdyn.frame(puma, "link6")(q)[:3, :3]
+    wb = [{"body": "link6", "frame": "body", "point": point, "force": R.T @ force, "moment": R.T @ moment}]
+    assert np.allclose(nhdyn.rne(puma, wrenches=wb)(q, qd, qdd), got, rtol=0, atol=1e-11)
+    # forward dynamics with the same wrenches inverts rne with them
+    assert np.allclose(nhdyn.forward_dynamics(puma, wrenches=w)(q, qd, got), qdd, rtol=0, atol=1e-9)
+    # constrained: paper5 pushed at its tip; forward dynamics inverts inverse dynamics
+    p5 = nhdyn.load("paper5")
+    q5, e, ed = rng.uniform(-1, 1, 5), rng.uniform(-1, 1, 4), rng.uniform(-1, 1, 4)
+    push = [{"body": "link5", "force": [0, 5.0, -3.0]}]
+    tau = nhdyn.inverse_dynamics(p5, wrenches=push)(q5, e, ed)
+    assert np.max(np.abs(tau - nhdyn.inverse_dynamics(p5)(q5, e, ed))) > 1e-3
+    assert np.allclose(nhdyn.forward_dynamics(p5, wrenches=push)(q5, e, tau), ed, rtol=0, atol=1e-9)
+    with pytest.raises(nhdyn.InputError, match="no body 'hand'"):
+        nhdyn.rne(puma, wrenches=[{"body": "hand"}])
+    with pytest.raises(nhdyn.InputError, match="unknown key 'torque'"):
+        nhdyn.rne(puma, wrenches=[{"body": "link6", "torque": [0, 0, 1]}])
+    # Friction of puma560_motors (Corke's drives on the joint side: B = G^2 B_m, Tc = |G| Tc_m;
+    # joint 1: G = -62.6111, B_m = 1.48e-3, Tc_m = (0.395, -0.435)): viscous plus Coulomb
+    motors = nhdyn.load("puma560_motors")
+    fr = nhdyn.friction(motors)
+    one = np.zeros(6)
+    one[0] = 1.0
+    assert fr(one)[0] == pytest.approx(62.6111**2 * 1.48e-3 + 62.6111 * 0.395, rel=1e-5)
+    assert fr(-one)[0] == pytest.approx(-(62.6111**2) * 1.48e-3 - 62.6111 * 0.435, rel=1e-5)
+    assert np.all(fr(np.zeros(6)) == 0)
+    assert np.allclose(fr(3 * one) - fr(2 * one), fr(2 * one) - fr(one), rtol=1e-14)  # linear beyond rest
+    smooth = nhdyn.friction(motors, smooth=0.01)(np.full(6, 1e-4))
+    assert np.all(np.abs(smooth) < np.abs(fr(np.full(6, 1e-4))))  # continuous through rest
+    with pytest.raises(nhdyn.InputError, match="smooth"):
+        nhdyn.friction(motors, smooth=-1)
+
+
+def test_the_one_state_fast_path_equals_the_general_path_and_the_cxx_loop():
+    m = nhdyn.load("paper5")
+    f = nhdyn.inverse_dynamics(m)
+    rng = np.random.default_rng(9)
+    Q, E, ED = rng.uniform(-1, 1, (50, 5)), rng.uniform(-1, 1, (50, 4)), rng.uniform(-1, 1, (50, 4))
+    loop = nhdyn._cxx_loop_inverse_dynamics(m, Q, E, ED)
+    assert np.array_equal(f(Q, E, ED), loop)
+    for i in range(50):
+        fast = f(Q[i].copy(), E[i].copy(), ED[i].copy())  # float64, contiguous: the fast path
+        general = f(Q[i], E[i].tolist(), np.repeat(ED[i], 2)[::2])  # a list, a strided view: the general path
+        assert np.array_equal(fast, loop[i]) and np.array_equal(general, loop[i])
+    strided = np.asfortranarray(np.vstack([Q[0], Q[0]]))[0]  # a non-contiguous row
+    assert not strided.flags["C_CONTIGUOUS"]
+    assert np.array_equal(f(strided, E[0], ED[0]), loop[0])
+    with pytest.raises(ValueError, match="'eta' has 3 entries; the model needs 4"):
+        f(Q[0], E[0][:3], ED[0])
