@@ -446,6 +446,26 @@ batch_function friction_of(const Model& mdl, double smooth) {
           }};
 }
 
+template <class Model, class C>
+batch_function lift_of(const Model& mdl, const C& c) {
+  const int n = mdl.dof(), m = c.m();
+  const auto f = nhdyn::lift(c);
+  return {"lift", {{"q", n}, {"eta", m}, {"eta_dot", m}}, {{"q", n}, {"qd", n}, {"qdd", n}}, [f, n, m](const auto& in, const auto& out) {
+            const auto xi = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)), VectorXd(cmap(in[2], m)));
+            vmap(out[0], n) = xi.q;
+            vmap(out[1], n) = xi.qd;
+            vmap(out[2], n) = xi.qdd;
+          }};
+}
+template <class Model, class C>
+batch_function project_of(const Model& mdl, const C& c) {
+  const int n = mdl.dof(), m = c.m();
+  const auto f = nhdyn::project(c);
+  return {"project", {{"q", n}, {"v", n}}, {{"tau", m}}, [f, n, m](const auto& in, const auto& out) {
+            vmap(out[0], m) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], n)));
+          }};
+}
+
 nhdyn::kinematics<double> kinematics_of(const nhdyn::chain<double>& c) { return nhdyn::kinematics<double>(c); }
 nhdyn::tree_kinematics<double> kinematics_of(const nhdyn::tree<double>& t) { return nhdyn::tree_kinematics<double>(t); }
 
@@ -734,6 +754,27 @@ The paper's nonholonomic inverse dynamics, project o rne o lift: q (n), eta and 
 named by model.eta) -> tau (m actuator forces). A model without a constraint: eta = qd, and
 this is rne. wrenches: external wrenches as for rne, inside the pipeline (lift | rne |
 wrenches | project).)");
+  mod.def("lift",
+          [](const model& m) {
+            return m.dispatch([](const auto& x, const auto& c) { return lift_of(x, c); },
+                              [&](const auto&) { return not_constrained(m, "lift"); });
+          },
+          py::arg("model"),
+          R"(lift(model) -> f(q, eta, eta_dot) -> (q, qd, qdd)
+
+The first stage of the paper's inverse dynamics: the stationary robot's state xi = (q, S eta,
+S eta_dot + Sdot eta) (n entries each). inverse_dynamics is project o rne o lift; compose your
+own in Python, e.g. project(q, rne(*lift(q, eta, eta_dot)) + friction(qd)).)");
+  mod.def("project",
+          [](const model& m) {
+            return m.dispatch([](const auto& x, const auto& c) { return project_of(x, c); },
+                              [&](const auto&) { return not_constrained(m, "project"); });
+          },
+          py::arg("model"),
+          R"(project(model) -> f(q, v) -> tau
+
+The last stage: the actuator forces tau = (S^T E)^-1 S^T v (m entries) that produce the
+generalized forces v (n entries) of the stationary robot along the admissible motions.)");
   mod.def("friction",
           [](const model& m, double smooth) {
             return m.dispatch([&](const auto& x, const auto&) { return friction_of(x, smooth); }, [&](const auto& x) { return friction_of(x, smooth); });

@@ -342,3 +342,24 @@ def test_the_one_state_fast_path_equals_the_general_path_and_the_cxx_loop():
     assert np.array_equal(f(strided, E[0], ED[0]), loop[0])
     with pytest.raises(ValueError, match="'eta' has 3 entries; the model needs 4"):
         f(Q[0], E[0][:3], ED[0])
+
+
+def test_stages_compose_in_python_as_the_paper_composes_them():
+    # inverse_dynamics = project o rne o lift, composed here from the three stages; and a
+    # stage of one's own (friction on the lifted rates) inserted between rne and project.
+    robot = os.path.join(SOURCE, "examples", "robots", "mobile_manipulator_wheels.json")
+    for spec in ("paper5", robot):
+        m = nhdyn.load(spec)
+        lift, rne, project = nhdyn.lift(m), nhdyn.rne(m), nhdyn.project(m)
+        rng = np.random.default_rng(3)
+        q, e, ed = rng.uniform(-1, 1, m.dof), rng.uniform(-1, 1, m.m), rng.uniform(-1, 1, m.m)
+        xq, xqd, xqdd = lift(q, e, ed)
+        assert np.array_equal(xq, q)
+        want = nhdyn.inverse_dynamics(m)(q, e, ed)
+        got = project(q, rne(xq, xqd, xqdd))
+        assert np.max(np.abs(got - want)) <= 1e-12 * max(1.0, np.max(np.abs(want)))
+        viscous = 0.7 * xqd  # a user's stage: 0.7 N m s/rad on every joint of the stationary robot
+        with_friction = project(q, rne(xq, xqd, xqdd) + viscous)
+        assert np.allclose(with_friction - got, project(q, viscous), rtol=0, atol=1e-12)  # project is linear in v
+    with pytest.raises(nhdyn.ModelError, match="no constraint"):
+        nhdyn.lift(nhdyn.load("puma560"))
