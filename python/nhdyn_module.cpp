@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <span>
 #include <filesystem>
 #include <fstream>
@@ -149,16 +150,18 @@ class batch_function {
         throw py::type_error(name_ + ": '" + arg + "' has dtype " + std::string(py::str(raw.dtype())) +
                              "; real numbers (float or int arrays, converted to float64) only");
       auto x = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(raw);
+      if (x && !(py::detail::array_proxy(x.ptr())->flags & py::detail::npy_api::NPY_ARRAY_ALIGNED_))
+        x = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(x.attr("copy")());  // aligned
       if (x.ndim() != 1 && x.ndim() != 2)
-        throw py::value_error(name_ + ": '" + arg + "' must be 1-D (one state) or 2-D (one state per row), not " +
+        throw nhdyn::input_error(name_ + ": '" + arg + "' must be 1-D (one state) or 2-D (one state per row), not " +
                               std::to_string(x.ndim()) + "-D");
       const py::ssize_t len = x.shape(x.ndim() - 1), rows = x.ndim() == 2 ? x.shape(0) : -1;
       if (len != n)
-        throw py::value_error(name_ + ": '" + arg + "' has " + std::to_string(len) + " entries; the model needs " +
+        throw nhdyn::input_error(name_ + ": '" + arg + "' has " + std::to_string(len) + " entries; the model needs " +
                               std::to_string(n));
       if (j == 0) batch = rows;
       else if (rows != batch)
-        throw py::value_error(name_ + ": '" + arg + "' is " + (rows < 0 ? "1-D" : std::to_string(rows) + " rows") + " but '" +
+        throw nhdyn::input_error(name_ + ": '" + arg + "' is " + (rows < 0 ? "1-D" : std::to_string(rows) + " rows") + " but '" +
                               args_[0].first + "' is " + (batch < 0 ? "1-D" : std::to_string(batch) + " rows"));
       in.push_back(std::move(x));
     }
@@ -203,11 +206,12 @@ class batch_function {
     if (threads > 1 || k != args_.size() || k > max_args || outs_.size() > max_outs) return std::nullopt;
     std::array<const double*, max_args> ip{};
     for (std::size_t j = 0; j < k; ++j) {
-      const py::handle h = PyTuple_GET_ITEM(a.ptr(), py::ssize_t(j));
-      if (!py::array_t<double, py::array::c_style>::check_(h)) return std::nullopt;
-      const auto& arr = reinterpret_cast<const py::array&>(h);  // a borrowed array: no reference taken
-      if (arr.ndim() != 1 || arr.shape(0) != args_[j].second) return std::nullopt;
-      ip[j] = static_cast<const double*>(arr.data());
+      const py::handle h = PyTuple_GET_ITEM(a.ptr(), py::ssize_t(j));  // borrowed: the tuple keeps it alive
+      if (!py::array_t<double, py::array::c_style>::check_(h)) return std::nullopt;  // native float64, C order
+      const auto* p = py::detail::array_proxy(h.ptr());
+      if (p->nd != 1 || p->dimensions[0] != args_[j].second || !(p->flags & py::detail::npy_api::NPY_ARRAY_ALIGNED_))
+        return std::nullopt;
+      ip[j] = reinterpret_cast<const double*>(p->data);
     }
     std::array<py::object, max_outs> out;
     std::array<double*, max_outs> op{};
@@ -218,6 +222,7 @@ class batch_function {
       out[o] = std::move(x);
     }
     f_(std::span<const double* const>(ip.data(), k), std::span<double* const>(op.data(), outs_.size()));
+    ++fast_calls;
     if (outs_.size() == 1) return std::move(out[0]);
     py::tuple t(outs_.size());
     for (std::size_t o = 0; o < outs_.size(); ++o) t[o] = std::move(out[o]);
@@ -279,6 +284,10 @@ class batch_function {
   std::vector<std::pair<std::string, int>> args_;
   std::vector<output> outs_;
   kernel f_;
+
+ public:
+  /// Calls that took call_one's path (nhdyn._fast_path_calls(): tests check which path ran).
+  static inline std::atomic<long long> fast_calls{0};
 };
 
 using rowmajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -368,7 +377,8 @@ std::vector<nhdyn::wrench<double>> wrenches_from(const Model& mdl, const py::lis
       if (k2 != "body" && k2 != "frame" && k2 != "point" && k2 != "force" && k2 != "moment")
         throw nhdyn::input_error(w + ": unknown key '" + k2 + "' (known: body, frame, point, force, moment)");
     }
-    if (!d.contains("body") || !py::isinstance<py::str>(d["body"])) throw nhdyn::input_error(w + ": 'body' (a body name) is missing");
+    if (!d.contains("body")) throw nhdyn::input_error(w + ": 'body' (a body name) is missing");
+    if (!py::isinstance<py::str>(d["body"])) throw nhdyn::input_error(w + ": 'body' must be a body's name (a string)");
     nhdyn::wrench_frame frame = nhdyn::wrench_frame::world;
     if (d.contains("frame")) {
       const std::string f = py::str(d["frame"]);
@@ -433,7 +443,9 @@ batch_function generalized_force_of(const Model& mdl, const py::list& w) {
   const int n = mdl.dof();
   const auto fx = nhdyn::external_wrenches(mdl, wrenches_from(mdl, w));
   return {"generalized_force", {{"q", n}}, {{"Q", n}}, [fx, n](const auto& in, const auto& out) {
-            vmap(out[0], n) = fx.generalized_force(VectorXd(cmap(in[0], n)));
+            const VectorXd q = cmap(in[0], n);
+            if (!q.allFinite()) throw nhdyn::input_error("generalized_force: q is not finite");
+            vmap(out[0], n) = fx.generalized_force(q);
           }};
 }
 template <class Model>
@@ -588,6 +600,7 @@ nhdyn::scene::search_path scene_dirs(const std::string& module_file) {
 struct python_controller {
   py::handle f;  // no reference counting: copied and destroyed without the GIL; the caller's object outlives the runs
   int m = 0;
+  std::atomic<bool>* interrupted = nullptr;  // set by Ctrl-C (KeyboardInterrupt) in f: the study stops
   template <class T>
   Eigen::Matrix<T, Eigen::Dynamic, 1> operator()(const Eigen::Matrix<T, Eigen::Dynamic, 1>& q,
                                                  const Eigen::Matrix<T, Eigen::Dynamic, 1>& eta, const nhdyn::vec3<T>& r,
@@ -613,6 +626,7 @@ struct python_controller {
         std::copy(tau.data(), tau.data() + m, t.data());
         return t;
       } catch (py::error_already_set& e) {
+        if (interrupted && (e.matches(PyExc_KeyboardInterrupt) || e.matches(PyExc_SystemExit))) *interrupted = true;
         throw std::runtime_error(std::string("Python controller: ") + e.what());
       }
     }
@@ -680,7 +694,7 @@ py::dict result_dict(const nhdyn::run_spec& spec, nhdyn::run_result& r) {
 }
 
 batch_function not_constrained(const model& m, const char* what) {
-  throw nhdyn::model_error("model '" + m.name + "' has no constraint: " + what + " needs one (use rne)");
+  throw nhdyn::model_error("model '" + m.name + "' has no constraint: " + what + " needs one (without one, inverse_dynamics is rne)");
 }
 
 }  // namespace
@@ -727,7 +741,7 @@ file (JSON with a "urdf" key: a URDF on a wheeled base with its constraint). str
 non-physical URDF inertia is an error instead of a warning on stderr. Raises ModelError
 with the file, link and field at fault.)");
   mod.def("rne", [](const model& m, const std::optional<py::list>& w) {
-            if (w) return m.dispatch([&](const auto& x, const auto&) { return rne_wrenches_of(x, *w); }, [&](const auto& x) { return rne_wrenches_of(x, *w); });
+            if (w && !w->empty()) return m.dispatch([&](const auto& x, const auto&) { return rne_wrenches_of(x, *w); }, [&](const auto& x) { return rne_wrenches_of(x, *w); });
             return m.dispatch([](const auto& x, const auto&) { return rne_of(x); }, [](const auto& x) { return rne_of(x); }); },
           py::arg("model"), py::arg("wrenches") = py::none(),
           R"(rne(model, wrenches=None) -> f(q, qd, qdd) -> tau
@@ -743,7 +757,7 @@ the body frame], "force": [N], "moment": [N m]}: tau - sum J^T [f; m].)");
           py::arg("model"), "bias(model) -> f(q, qd) -> h = C(q, qd) qd + g(q) (n entries)");
   mod.def("inverse_dynamics",
           [](const model& m, const std::optional<py::list>& w) {
-            if (w)
+            if (w && !w->empty())
               return m.dispatch([&](const auto& x, const auto& c) { return nh_id_wrenches_of(x, c, *w); },
                                 [&](const auto& x) { return rne_wrenches_of(x, *w); });
             return m.dispatch([](const auto& x, const auto& c) { return nh_id_of(x, c); }, [](const auto& x) { return rne_of(x); }); },
@@ -764,7 +778,8 @@ wrenches | project).)");
 
 The first stage of the paper's inverse dynamics: the stationary robot's state xi = (q, S eta,
 S eta_dot + Sdot eta) (n entries each). inverse_dynamics is project o rne o lift; compose your
-own in Python, e.g. project(q, rne(*lift(q, eta, eta_dot)) + friction(qd)).)");
+own in Python, e.g. xq, xqd, xqdd = lift(q, eta, eta_dot); project(q, rne(xq, xqd, xqdd) +
+friction(xqd)).)");
   mod.def("project",
           [](const model& m) {
             return m.dispatch([](const auto& x, const auto& c) { return project_of(x, c); },
@@ -784,7 +799,8 @@ generalized forces v (n entries) of the stationary robot along the admissible mo
 
 The joints' friction from the model (JSON "friction"/"motor", URDF <dynamics damping
 friction>): tau_f,i = B_i qd_i + c_i(qd_i), c = c+ for qd > 0, c- for qd < 0, 0 at rest.
-smooth = v_s > 0 [rad/s or m/s]: c+ qd / sqrt(qd^2 + v_s^2) instead (continuous). What the
+smooth = v_s > 0 [rad/s or m/s]: c+ s(qd) for qd > 0 and -c- s(qd) below, s = qd /
+sqrt(qd^2 + v_s^2), instead (continuous through rest). What the
 drives must add to rne's torque: rne(model)(q, qd, qdd) + friction(model)(qd).)");
   mod.def("generalized_force",
           [](const model& m, const py::list& w) {
@@ -800,6 +816,8 @@ generalized forces (rne with them is rne - Q).)");
   // τ stored row by row), compiled in this module with its flags: the reference that
   // bench/python_bench.py measures the batched call against, in the same process on the
   // same arrays (issue 16: 10⁶ paper5 inverse dynamics from Python within 1.5× of it).
+  mod.def("_fast_path_calls", [] { return batch_function::fast_calls.load(); },
+          "How many one-state calls took the in-place path so far (tests check which path ran).");
   mod.def("_cxx_loop_inverse_dynamics",
           [](const model& m, const py::array_t<double, py::array::c_style | py::array::forcecast>& Q,
              const py::array_t<double, py::array::c_style | py::array::forcecast>& E,
@@ -823,7 +841,7 @@ generalized forces (rne with them is rne - Q).)");
                   }
                   return 0;
                 },
-                [&](const auto&) -> int { throw nhdyn::input_error("_cxx_loop_inverse_dynamics: a constrained model"); });
+                [&](const auto&) -> int { throw nhdyn::input_error("_cxx_loop_inverse_dynamics: needs a constrained model"); });
             return out;
           },
           py::arg("model"), py::arg("q"), py::arg("eta"), py::arg("eta_dot"),
@@ -873,7 +891,7 @@ base frame: rows 0-2 the point's velocity [m/s], rows 3-5 the angular velocity [
 unit qd.)");
   mod.def("forward_dynamics",
           [](const model& m, const std::optional<py::list>& w) {
-            if (w)
+            if (w && !w->empty())
               return m.dispatch([&](const auto& x, const auto& c) { return nh_fd_wrenches_of(x, c, *w); },
                                 [&](const auto& x) { return holonomic_fd_wrenches_of(x, *w); });
             return m.dispatch([](const auto& x, const auto& c) { return nh_fd_of(x, c); }, [](const auto& x) { return holonomic_fd_of(x); }); },
@@ -918,13 +936,21 @@ InputError for lo > hi or NaN, NumericalError for a box too wide to bound.)");
             if (!controller.is_none()) {
 #if NHDYN_PY_URDF
               if (!PyCallable_Check(controller.ptr())) throw nhdyn::input_error("nhdyn.simulate: controller must be callable");
+              std::atomic<bool> interrupted{false};
               const auto with_python = [&](const nhdyn::run_spec& s) {
+                if (interrupted) throw nhdyn::input_error("not run: interrupted (KeyboardInterrupt)");
                 return nhdyn::simulate_scene_with(s, [&](const auto&, const auto& c, int, const auto&, const auto&, const auto&) {
-                  return python_controller{controller, c.m()};
+                  return python_controller{controller, c.m(), &interrupted};
                 });
               };
-              py::gil_scoped_release release;  // the callbacks take it back
-              results = nhdyn::run_batch(specs, 1, [](std::size_t, nhdyn::run_result&) {}, with_python);
+              {
+                py::gil_scoped_release release;  // the callbacks take it back
+                results = nhdyn::run_batch(specs, 1, [](std::size_t, nhdyn::run_result&) {}, with_python);
+              }
+              if (interrupted) {
+                PyErr_SetNone(PyExc_KeyboardInterrupt);
+                throw py::error_already_set();
+              }
 #else
               throw nhdyn::input_error("nhdyn.simulate: a Python controller needs nhdyn built with URDF support");
 #endif

@@ -48,11 +48,12 @@ compiler="$("$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt"
   --cpu "$cpu" --compiler "$compiler"
 
 # The Python module's call overhead and batch throughput (issue 16), when it can be built.
-if make -C "$build" -j2 nhdyn_python >/dev/null 2>&1 && [ -d "$build/python" ]; then
+if grep -q '^NHDYN_BUILD_PYTHON:BOOL=ON' "$build/CMakeCache.txt"; then
+  make -C "$build" -j2 nhdyn_python   # a failure here is a real one: it stops the script
   PYTHONPATH="$build/python" "$py" "$root/bench/python_bench.py" "$root/docs/performance-python.json" \
     --doc "$root/docs/performance.md"
 else
-  echo "bench.sh: the Python module was not built (pybind11-dev, python3-dev, python3-numpy): no Python benchmark"
+  echo "bench.sh: the Python module is not configured (pybind11-dev, python3-dev, python3-numpy): no Python benchmark"
 fi
 
 if [ "$scalar" = 1 ]; then

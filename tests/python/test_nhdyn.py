@@ -288,11 +288,22 @@ def test_wrenches_and_friction_from_python():
     q, qd, qdd = (rng.uniform(-1, 1, 6) for _ in range(3))
     point, force, moment = np.array([0.01, 0.02, 0.05]), np.array([3.0, -2.0, 5.0]), np.array([0.4, 0.1, -0.3])
     w = [{"body": "link6", "point": point, "force": force, "moment": moment}]
-    J = nhdyn.jacobian(puma, "link6", point)(q)
+    # the point's Jacobian by central differences of its pose (nhdyn.frame): velocity rows
+    # from the point's position, angular rows from R(q + h e_j) R(q - h e_j)^T
+    pose = nhdyn.frame(puma, "link6")
+    h, J = 1e-6, np.zeros((6, 6))
+    for j in range(6):
+        d = np.zeros(6)
+        d[j] = h
+        Tp, Tm = pose(q + d), pose(q - d)
+        J[:3, j] = (Tp[:3, :3] @ point + Tp[:3, 3] - Tm[:3, :3] @ point - Tm[:3, 3]) / (2 * h)
+        W = Tp[:3, :3] @ Tm[:3, :3].T
+        J[3:, j] = np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1]]) / (4 * h)
     want = nhdyn.rne(puma)(q, qd, qdd) - J[:3].T @ force - J[3:].T @ moment
     got = nhdyn.rne(puma, wrenches=w)(q, qd, qdd)
-    assert np.max(np.abs(got - want)) < 1e-12 * max(1.0, np.max(np.abs(want)))
-    assert np.allclose(nhdyn.generalized_force(puma, w)(q), J[:3].T @ force + J[3:].T @ moment, rtol=0, atol=1e-13)
+    assert np.max(np.abs(got - want)) < 1e-7 * max(1.0, np.max(np.abs(want)))
+    assert np.array_equal(nhdyn.rne(puma)(q, qd, qdd) - nhdyn.generalized_force(puma, w)(q), got)
+    assert np.array_equal(nhdyn.rne(puma, wrenches=[])(q, qd, qdd), nhdyn.rne(puma)(q, qd, qdd))
     # body axes: the same wrench rotated into the body frame is the same physics
     R = nhdyn.frame(puma, "link6")(q)[:3, :3]
     wb = [{"body": "link6", "frame": "body", "point": point, "force": R.T @ force, "moment": R.T @ moment}]
@@ -320,8 +331,13 @@ def test_wrenches_and_friction_from_python():
     assert fr(-one)[0] == pytest.approx(-(62.6111**2) * 1.48e-3 - 62.6111 * 0.435, rel=1e-5)
     assert np.all(fr(np.zeros(6)) == 0)
     assert np.allclose(fr(3 * one) - fr(2 * one), fr(2 * one) - fr(one), rtol=1e-14)  # linear beyond rest
-    smooth = nhdyn.friction(motors, smooth=0.01)(np.full(6, 1e-4))
-    assert np.all(np.abs(smooth) < np.abs(fr(np.full(6, 1e-4))))  # continuous through rest
+    # the smooth law: c+ s(qd) above rest, -c- s(qd) below, s = qd / sqrt(qd^2 + v_s^2); B = 5.80182
+    sm = nhdyn.friction(motors, smooth=0.01)
+    for v in (1e-4, 0.01, 0.5):
+        s_ = v / np.sqrt(v * v + 1e-4)
+        assert sm(v * one)[0] == pytest.approx(5.8018217679508 * v + 24.7313845 * s_, rel=1e-12)
+        assert sm(-v * one)[0] == pytest.approx(-5.8018217679508 * v - 27.2358285 * s_, rel=1e-12)
+    assert np.all(sm(np.zeros(6)) == 0)
     with pytest.raises(nhdyn.InputError, match="smooth"):
         nhdyn.friction(motors, smooth=-1)
 
@@ -334,13 +350,28 @@ def test_the_one_state_fast_path_equals_the_general_path_and_the_cxx_loop():
     loop = nhdyn._cxx_loop_inverse_dynamics(m, Q, E, ED)
     assert np.array_equal(f(Q, E, ED), loop)
     for i in range(50):
+        before = nhdyn._fast_path_calls()
         fast = f(Q[i].copy(), E[i].copy(), ED[i].copy())  # float64, contiguous: the fast path
+        assert nhdyn._fast_path_calls() == before + 1
         general = f(Q[i], E[i].tolist(), np.repeat(ED[i], 2)[::2])  # a list, a strided view: the general path
+        assert nhdyn._fast_path_calls() == before + 1
         assert np.array_equal(fast, loop[i]) and np.array_equal(general, loop[i])
+    # arrays the fast path must not take as they are: big-endian, misaligned; read-only is fine
+    before = nhdyn._fast_path_calls()
+    assert np.array_equal(f(Q[0].astype(">f8"), E[0], ED[0]), loop[0])
+    buf = bytearray(5 * 8 + 1)
+    buf[1:41] = Q[0].tobytes()
+    misaligned = np.frombuffer(bytes(buf), dtype="<f8", count=5, offset=1)
+    assert not misaligned.flags["ALIGNED"]
+    assert np.array_equal(f(misaligned, E[0], ED[0]), loop[0])
+    assert nhdyn._fast_path_calls() == before
+    readonly = Q[0].copy()
+    readonly.flags.writeable = False
+    assert np.array_equal(f(readonly, E[0], ED[0]), loop[0]) and nhdyn._fast_path_calls() == before + 1
     strided = np.asfortranarray(np.vstack([Q[0], Q[0]]))[0]  # a non-contiguous row
     assert not strided.flags["C_CONTIGUOUS"]
     assert np.array_equal(f(strided, E[0], ED[0]), loop[0])
-    with pytest.raises(ValueError, match="'eta' has 3 entries; the model needs 4"):
+    with pytest.raises(nhdyn.InputError, match="'eta' has 3 entries; the model needs 4"):
         f(Q[0], E[0][:3], ED[0])
 
 
@@ -358,8 +389,15 @@ def test_stages_compose_in_python_as_the_paper_composes_them():
         want = nhdyn.inverse_dynamics(m)(q, e, ed)
         got = project(q, rne(xq, xqd, xqdd))
         assert np.max(np.abs(got - want)) <= 1e-12 * max(1.0, np.max(np.abs(want)))
-        viscous = 0.7 * xqd  # a user's stage: 0.7 N m s/rad on every joint of the stationary robot
-        with_friction = project(q, rne(xq, xqd, xqdd) + viscous)
-        assert np.allclose(with_friction - got, project(q, viscous), rtol=0, atol=1e-12)  # project is linear in v
+        # project's defining property, with lift's S: the actuators' generalized force E tau does
+        # the same work as v along every admissible motion S eta, (E tau)·(S eta) = v·(S eta).
+        v = rng.uniform(-1, 1, m.dof)
+        tau = project(q, v)
+        if spec == "paper5":  # no input map, E = S: E tau = S tau = lift's rate of "eta" = tau
+            e_tau = lift(q, tau, np.zeros(m.m))[1]
+        else:  # the wheels robot: E places tau on the actuated joints, SᵀE = I, so (E tau)·(S eta) = tau·eta
+            e_tau = None
+        work = e_tau @ xqd if e_tau is not None else tau @ e
+        assert work == pytest.approx(v @ xqd, rel=1e-12)
     with pytest.raises(nhdyn.ModelError, match="no constraint"):
         nhdyn.lift(nhdyn.load("puma560"))

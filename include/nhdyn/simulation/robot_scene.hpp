@@ -69,7 +69,8 @@ inline tree<double> with_length_factors(const tree<double>& t, const std::vector
                                         const std::string& where) {
   if (factors.empty()) return t;
   std::vector<body<double>> B(t.begin(), t.end());
-  for (const auto& [name, f] : factors) {
+  for (const auto& [joint, f] : factors) {
+    const std::string& name = joint;  // (clang 14 cannot capture a structured binding)
     const auto it = std::find_if(B.begin(), B.end(), [&](const auto& b) { return b.joint_name == name; });
     if (it == B.end())
       throw input_error(where + "no movable joint named '" + name + "' for a length factor (joints: " +
