@@ -278,6 +278,17 @@ def test_a_python_controller_drives_a_scene_as_the_same_law_in_cpp_does():
     assert not short["success"] and "6 numbers" in short["failure"]
     with pytest.raises(nhdyn.InputError, match="callable"):
         nhdyn.simulate(scene, controller=3)
+    # Ctrl-C in the controller stops a study: the KeyboardInterrupt comes back, after one call
+    study = {"name": "ct-study", "study": {"base": scene, "factors": [{"path": "/controller/kp", "levels": [300, 400, 500]}]}}
+    seen = []
+
+    def interrupted(q, eta, r, ref):
+        seen.append(1)
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        nhdyn.simulate(study, controller=interrupted)
+    assert len(seen) == 1
 
 
 def test_wrenches_and_friction_from_python():
