@@ -35,11 +35,12 @@ namespace nhdyn_tool {
 namespace {
 constexpr std::string_view usage = R"(nhdyn simulate SCENE... --out DIR [--threads N] [--no-plots]
   Runs each SCENE (a JSON file, or the name of a shipped scene: paper-circle,
-  paper-factorial, paper-noise, paper = all three; shipped scenes are read from
+  paper-factorial, paper-noise, paper = all three, mobile-manipulator-circle,
+  mobile-manipulator-monte-carlo, puma560-line, puma560-computed-torque; shipped scenes are read from
   share/nhdyn/scenes beside the tool's bin/ folder, or from $NHDYN_SCENES_DIR) and writes
   into DIR (created):
     DIR/<run>.csv       t,q1..q5,eta1..eta4,tau1..tau4,r_x,r_y,r_z,rd_x,rd_y,rd_z,err at the
-                        scene's output step, from dense output (a robot file's scene:
+                        scene's output step, from dense output (any other robot's scene:
                         q_<joint>..., eta_<name>..., tau_<name>... by its names); tau is the torque applied
                         (the held value under zero-order hold), r the plant's true position,
                         err = |r_d - r|; numbers round-trip exact
@@ -469,7 +470,7 @@ int run(const std::vector<std::string>& args) {
   std::size_t done = 0;
   const auto t0 = std::chrono::steady_clock::now();
 #ifdef NHDYN_TOOL_URDF
-  const auto runner = nhdyn::simulate_scene;  // paper5 and robot files
+  const auto runner = nhdyn::simulate_scene;  // paper5 and any other model
 #else
   const auto runner = nhdyn::simulate;  // paper5 only (robot files need URDF support)
 #endif
