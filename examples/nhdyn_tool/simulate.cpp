@@ -67,6 +67,33 @@ struct group {
   std::vector<std::size_t> runs;
 };
 
+/// The 1-based (gnuplot) number of the column called `name`; 0 if there is none.
+int column_of(const std::vector<std::string>& columns, const std::string& name) {
+  for (std::size_t j = 0; j < columns.size(); ++j)
+    if (columns[j] == name) return int(j) + 1;
+  return 0;
+}
+
+/// A figure of one panel per column whose name starts with `prefix_of` (three per row from
+/// five panels on): DIR/<group><file>, titled `title`; each panel labelled with the column's
+/// name (without the prefix when `strip`) and drawn by `panel(column)`.
+template <class Panel>
+void panel_grid(std::ostringstream& p, const std::string& prefix, const char* file, const std::string& title,
+                const std::vector<std::string>& columns, const std::string& prefix_of, bool strip, const Panel& panel) {
+  std::vector<int> cs;
+  for (std::size_t j = 1; j < columns.size(); ++j)
+    if (columns[j].rfind(prefix_of, 0) == 0) cs.push_back(int(j) + 1);
+  const int per_row = cs.size() > 4 ? 3 : 1, rows = (int(cs.size()) + per_row - 1) / per_row;
+  p << "set terminal pngcairo size " << (per_row > 1 ? 1400 : 900) << "," << std::max(400, 170 * rows)
+    << " noenhanced font ',9'\nset output '" << prefix << file << "'\nset multiplot layout " << rows << "," << per_row
+    << " title '" << title << "'\nunset title\nset xlabel ''\nset key off\n";
+  for (int c : cs) {
+    p << "set ylabel '" << columns[std::size_t(c - 1)].substr(strip ? prefix_of.size() : 0) << "'\n";
+    panel(c);
+  }
+  p << "unset multiplot\nset key\n";
+}
+
 /// gnuplot program for one group's figures (figs. 4–6 of the paper, and τ(t)). Every run is
 /// one line style throughout (colour and dash) and named in the legend by what sets it apart
 /// (its name without the group's prefix, e.g. "m3_1.1-d3_0.9-a4_1-a5_1"). `columns`: the
@@ -90,11 +117,7 @@ std::string gnuplot_program(const std::filesystem::path& dir, const group& g, co
   p << "'\nn = words(files)\nstyle(i) = 1 + int((i - 1) / 8) % 5\nset grid\n";
   p << (many ? "set key outside right top vertical font ',8' title 'run'\n" : "set key top right\n");
   const bool paper5 = columns == nhdyn::run_columns();
-  const auto col = [&](const std::string& name) {
-    for (std::size_t j = 0; j < columns.size(); ++j)
-      if (columns[j] == name) return int(j) + 1;
-    return 0;
-  };
+  const auto col = [&](const std::string& name) { return column_of(columns, name); };
   if (!paper5) {  // any robot: the same figures, from the column names
     p << "set output '" << prefix << "-path.png'\nset title '" << g.name << ": task point seen from above'\n"
       << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset size ratio -1\n"
@@ -105,21 +128,9 @@ std::string gnuplot_program(const std::filesystem::path& dir, const group& g, co
       << ": tracking error |r_d - r|'\nset xlabel 't [s]'\nset ylabel '|r_d - r| [m]'\nset logscale y\n"
       << "plot for [i=1:n] word(files,i) every ::1 using 1:" << col("err") << " with lines lc i dt style(i) title word(titles,i)\n"
       << "unset logscale y\n";
-    const auto grid = [&](const char* file, const char* what, const std::string& prefix_of) {
-      std::vector<int> cs;
-      for (std::size_t j = 0; j < columns.size(); ++j)
-        if (columns[j].rfind(prefix_of, 0) == 0) cs.push_back(int(j) + 1);
-      const int per_row = cs.size() > 4 ? 3 : 1, rows = (int(cs.size()) + per_row - 1) / per_row;
-      p << "set terminal pngcairo size " << (per_row > 1 ? 1400 : 900) << "," << std::max(400, 170 * rows)
-        << " noenhanced font ',9'\nset output '" << prefix << file << "'\nset multiplot layout " << rows << "," << per_row
-        << " title '" << g.name << ": " << what << "'\nunset title\nset xlabel ''\nset key off\n";
-      for (int c : cs)
-        p << "set ylabel '" << columns[std::size_t(c - 1)].substr(prefix_of.size()) << "'\nplot for [i=1:n] word(files,i) every ::1 using 1:"
-          << c << " with lines lc i dt style(i)\n";
-      p << "unset multiplot\nset key\n";
-    };
-    grid("-q.png", "joint coordinates q (t)", "q_");
-    grid("-tau.png", "actuator forces and torques applied (t)", "tau_");
+    const auto lines = [&](int c) { p << "plot for [i=1:n] word(files,i) every ::1 using 1:" << c << " with lines lc i dt style(i)\n"; };
+    panel_grid(p, prefix, "-q.png", g.name + ": joint coordinates q (t)", columns, "q_", true, lines);
+    panel_grid(p, prefix, "-tau.png", g.name + ": actuator forces and torques applied (t)", columns, "tau_", true, lines);
     return p.str();
   }
   p << "set output '" << prefix << "-path.png'\nset title '" << g.name
@@ -256,11 +267,7 @@ std::string gnuplot_bands(const std::filesystem::path& dir, const group& g, cons
   std::ostringstream p;
   const std::string prefix = (dir / g.name).string(), bands = prefix + "-bands.csv";
   const bool paper5 = columns == nhdyn::run_columns();
-  const auto col = [&](const std::string& name) {
-    for (std::size_t j = 0; j < columns.size(); ++j)
-      if (columns[j] == name) return int(j) + 1;
-    return 0;
-  };
+  const auto col = [&](const std::string& name) { return column_of(columns, name); };
   // column c (1-based in a run's CSV, c ≥ 2) → its five columns in bands.csv (q: 0 min … 4 max)
   const auto band = [&](int c, int q) { return 2 + 5 * (c - 2) + q; };
   const std::string of = std::to_string(used) + " of " + std::to_string(g.runs.size()) + " runs";
@@ -288,22 +295,11 @@ std::string gnuplot_bands(const std::filesystem::path& dir, const group& g, cons
     << "'\nset xlabel 't [s]'\nset ylabel '|r_d - r| [m]'\nset logscale y\n";
   plot_band(col("err"), true);
   p << "unset logscale y\n";
-  const auto grid = [&](const char* file, const char* what, const std::string& prefix_of) {
-    std::vector<int> cs;
-    for (std::size_t j = 1; j < columns.size(); ++j)
-      if (columns[j].rfind(prefix_of, 0) == 0) cs.push_back(int(j) + 1);
-    const int per_row = cs.size() > 4 ? 3 : 1, rows = (int(cs.size()) + per_row - 1) / per_row;
-    p << "set terminal pngcairo size " << (per_row > 1 ? 1400 : 900) << "," << std::max(400, 170 * rows)
-      << " noenhanced font ',9'\nset output '" << prefix << file << "'\nset multiplot layout " << rows << "," << per_row
-      << " title '" << g.name << ": " << what << ", " << of << " (median, 5-95 %, min-max)'\nunset title\nset xlabel ''\nset key off\n";
-    for (int c : cs) {
-      p << "set ylabel '" << columns[std::size_t(c - 1)].substr(paper5 ? 0 : prefix_of.size()) << "'\n";
-      plot_band(c, false);
-    }
-    p << "unset multiplot\nset key\n";
-  };
-  grid("-q.png", "joint coordinates q (t)", paper5 ? "q" : "q_");
-  grid("-tau.png", "actuator forces and torques applied (t)", paper5 ? "tau" : "tau_");
+  const auto bands_of = [&](int c) { plot_band(c, false); };
+  const std::string how = ", " + of + " (median, 5-95 %, min-max)";
+  panel_grid(p, prefix, "-q.png", g.name + ": joint coordinates q (t)" + how, columns, paper5 ? "q" : "q_", !paper5, bands_of);
+  panel_grid(p, prefix, "-tau.png", g.name + ": actuator forces and torques applied (t)" + how, columns, paper5 ? "tau" : "tau_",
+             !paper5, bands_of);
   return p.str();
 }
 
