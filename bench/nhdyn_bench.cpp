@@ -27,8 +27,13 @@
 #include <cstdlib>
 #include <memory>
 
+#include <nhdyn/analysis/batch.hpp>
+#include <nhdyn/analysis/derivatives.hpp>
+#include <nhdyn/analysis/linearize.hpp>
 #include <nhdyn/dynamics/aba.hpp>
 #include <nhdyn/dynamics/reference.hpp>
+#include <nhdyn/dynamics/reference_derivatives.hpp>
+#include <nhdyn/dynamics/rne_derivatives.hpp>
 #include <nhdyn/dynamics/tree.hpp>
 #ifdef NHDYN_BENCH_URDF
 #include <nhdyn/io/robot_file.hpp>
@@ -436,6 +441,188 @@ void register_tree(const std::string& model, const nhdyn::tree<double>& t) {
   add("rne/" + model + "/kdl", [k]() { benchmark::DoNotOptimize(kdl::run_tree(k.get())); });
 }
 
+// ------------------------------------------- issue 18: analytic derivatives of rne on trees
+
+/// deriv_rne/<model>/{rne, analytic, dual}: one double rne of the tree (the tree kernel), the
+/// analytic ∂τ/∂(q, q̇) (and M) into a reused result, and the same Jacobian by dual numbers
+/// through the tree kernel (8 directions per pass); deriv_rne_pair/<model>: rne and analytic
+/// paired (ratio = analytic / rne).
+void register_deriv(const std::string& model, const nhdyn::tree<double>& t) {
+  const int n = t.dof();
+  const state s = random_state(n);
+  const auto id = nhdyn::rne(t);
+  const auto d = nhdyn::rne_derivatives(t);
+  const auto r = d(s.q, s.qd, s.qdd);
+  const auto [rq, rqd] = nhdyn::reference::rne_derivatives(t, s.q, s.qd, s.qdd);
+  const auto flat = [](const Eigen::MatrixXd& m) { return Eigen::Map<const Eigen::VectorXd>(m.data(), m.size()); };
+  agree(flat(r.dq), flat(rq), 1e-11, "deriv_rne/" + model + ": dtau/dq analytic vs reference");
+  agree(flat(r.dqd), flat(rqd), 1e-11, "deriv_rne/" + model + ": dtau/dqd analytic vs reference");
+  const auto by_duals = [id, n](const Eigen::VectorXd& x, const Eigen::VectorXd& qdd) {
+    return nhdyn::jacobian([&](const auto& z) { return id(z.head(n), z.tail(n), qdd.cast<typename std::decay_t<decltype(z)>::Scalar>().eval()); }, x);
+  };
+  Eigen::VectorXd x(2 * n);
+  x << s.q, s.qd;
+  const Eigen::MatrixXd J = by_duals(x, s.qdd);
+  agree(flat(J.leftCols(n)), flat(r.dq), 1e-11, "deriv_rne/" + model + ": dtau/dq duals vs analytic");
+  const auto rne_call = [id, s]() mutable {
+    opaque(s.q), opaque(s.qd), opaque(s.qdd);
+    auto v = id(s.q, s.qd, s.qdd);
+    benchmark::DoNotOptimize(v);
+  };
+  auto out = std::make_shared<nhdyn::rne_derivatives_result<double>>(r);
+  const auto analytic_call = [d, s, out]() mutable {
+    opaque(s.q), opaque(s.qd), opaque(s.qdd);
+    d.evaluate(s.q, s.qd, s.qdd, *out);
+    benchmark::DoNotOptimize(out->dq.data());
+  };
+  add("deriv_rne/" + model + "/rne", rne_call);
+  add("deriv_rne/" + model + "/analytic", analytic_call);
+  add("deriv_rne/" + model + "/dual", [by_duals, x, s]() mutable {
+    opaque(x);
+    auto J = by_duals(x, s.qdd);
+    benchmark::DoNotOptimize(J.data());
+  });
+  add_paired("deriv_rne_pair/" + model, rne_call, analytic_call);
+}
+
+/// deriv_fd/<model>/{fd, analytic, dual}: one holonomic forward dynamics call, its analytic
+/// A, B (forward_dynamics_derivatives: q̈, ∂q̈/∂(q, q̇), M⁻¹) and the same by duals
+/// (linearize_forward_dynamics, 3n directions).
+void register_deriv_fd(const std::string& model, const nhdyn::tree<double>& t) {
+  const int n = t.dof();
+  const state s = random_state(n);
+  const Eigen::VectorXd tau = nhdyn::rne(t)(s.q, s.qd, s.qdd);
+  const auto fd = nhdyn::forward_dynamics(t);
+  const auto d = nhdyn::forward_dynamics_derivatives(t);
+  const auto a = d(s.q, s.qd, tau);
+  const auto b = nhdyn::linearize_forward_dynamics(t, s.q, s.qd, tau);
+  const auto A = a.state_space_model().A;
+  agree(Eigen::Map<const Eigen::VectorXd>(A.data(), A.size()), Eigen::Map<const Eigen::VectorXd>(b.A.data(), b.A.size()),
+        1e-9, "deriv_fd/" + model + ": analytic vs duals");
+  add("deriv_fd/" + model + "/fd", [fd, s, tau]() mutable {
+    opaque(s.q), opaque(s.qd), opaque(tau);
+    auto r = fd(s.q, s.qd, tau);
+    benchmark::DoNotOptimize(r);
+  });
+  add("deriv_fd/" + model + "/analytic", [d, s, tau]() mutable {
+    opaque(s.q), opaque(s.qd), opaque(tau);
+    auto r = d(s.q, s.qd, tau);
+    benchmark::DoNotOptimize(r.dq.data());
+  });
+  add("deriv_fd/" + model + "/dual", [t, s, tau]() mutable {
+    opaque(s.q), opaque(s.qd), opaque(tau);
+    auto r = nhdyn::linearize_forward_dynamics(t, s.q, s.qd, tau);
+    benchmark::DoNotOptimize(r.A.data());
+  });
+}
+
+/// deriv_nh/<model>/{nh, analytic, dual}: one nonholonomic inverse dynamics call, its analytic
+/// ∂τ/∂(q, η, η̇) (inverse_dynamics_derivatives) and the same by duals
+/// (inverse_dynamics_linearizer, built once); deriv_nh_pair/<model>: nh and analytic paired;
+/// deriv_nh_fd/<model>/{fd, analytic, dual}: the constrained forward dynamics and its A, B.
+template <class C>
+void register_deriv_nh(const std::string& model, const nhdyn::tree<double>& t, const C& c) {
+  const int n = c.dof(), m = c.m();
+  const state s = random_state(n);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  const Eigen::VectorXd q = s.q, eta = Eigen::VectorXd::NullaryExpr(m, [&] { return U(rng); }),
+                        eta_dot = Eigen::VectorXd::NullaryExpr(m, [&] { return U(rng); });
+  const auto id = nhdyn::inverse_dynamics(t, c);
+  const auto d = nhdyn::inverse_dynamics_derivatives(t, c);
+  const nhdyn::inverse_dynamics_linearizer lin(t, c);
+  const auto J = d(q, eta, eta_dot).J();
+  const auto Jd = lin(q, eta, eta_dot).J;
+  agree(Eigen::Map<const Eigen::VectorXd>(J.data(), J.size()), Eigen::Map<const Eigen::VectorXd>(Jd.data(), Jd.size()),
+        1e-11, "deriv_nh/" + model + ": analytic vs duals");
+  const auto nh_call = [id, q, eta, eta_dot]() mutable {
+    opaque(q), opaque(eta), opaque(eta_dot);
+    auto r = id(q, eta, eta_dot);
+    benchmark::DoNotOptimize(r);
+  };
+  const auto analytic_call = [d, q, eta, eta_dot]() mutable {
+    opaque(q), opaque(eta), opaque(eta_dot);
+    auto r = d(q, eta, eta_dot);
+    benchmark::DoNotOptimize(r.dq.data());
+  };
+  add("deriv_nh/" + model + "/nh", nh_call);
+  add("deriv_nh/" + model + "/analytic", analytic_call);
+  add("deriv_nh/" + model + "/dual", [lin, q, eta, eta_dot]() mutable {
+    opaque(q), opaque(eta), opaque(eta_dot);
+    auto r = lin(q, eta, eta_dot);
+    benchmark::DoNotOptimize(r.J.data());
+  });
+  add_paired("deriv_nh_pair/" + model, nh_call, analytic_call);
+  const Eigen::VectorXd tau = id(q, eta, eta_dot);
+  const auto fd = nhdyn::nh_forward_dynamics(t, c);
+  const auto fdd = nhdyn::forward_dynamics_derivatives(t, c);
+  const nhdyn::forward_dynamics_linearizer fdl(t, c);
+  const auto A = fdd(q, eta, tau).ss.A;
+  const auto Ad = fdl(q, eta, tau).A;
+  agree(Eigen::Map<const Eigen::VectorXd>(A.data(), A.size()), Eigen::Map<const Eigen::VectorXd>(Ad.data(), Ad.size()),
+        1e-9, "deriv_nh_fd/" + model + ": analytic vs duals");
+  add("deriv_nh_fd/" + model + "/fd", [fd, q, eta, tau]() mutable {
+    opaque(q), opaque(eta), opaque(tau);
+    auto r = fd(q, eta, tau);
+    benchmark::DoNotOptimize(r);
+  });
+  add("deriv_nh_fd/" + model + "/analytic", [fdd, q, eta, tau]() mutable {
+    opaque(q), opaque(eta), opaque(tau);
+    auto r = fdd(q, eta, tau);
+    benchmark::DoNotOptimize(r.ss.A.data());
+  });
+  add("deriv_nh_fd/" + model + "/dual", [fdl, q, eta, tau]() mutable {
+    opaque(q), opaque(eta), opaque(tau);
+    auto r = fdl(q, eta, tau);
+    benchmark::DoNotOptimize(r.A.data());
+  });
+}
+
+/// batch_rne/<model>/{one, batch}: one double rne of the tree (run-time sized), and
+/// rne_batch over 256 states in one call (time per call: divide by 256 for a state);
+/// batch_fd/<model>/{one, batch}: the same for aba and forward_dynamics_batch.
+constexpr int batch_states = 256;
+void register_batch(const std::string& model, const nhdyn::tree<double>& t) {
+  const int n = t.dof();
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  const Eigen::MatrixXd Q = Eigen::MatrixXd::NullaryExpr(n, batch_states, [&] { return 3 * U(rng); }),
+                        QD = Eigen::MatrixXd::NullaryExpr(n, batch_states, [&] { return U(rng); }),
+                        QDD = Eigen::MatrixXd::NullaryExpr(n, batch_states, [&] { return U(rng); });
+  const auto id = nhdyn::rne(t);
+  const auto b = nhdyn::rne_batch(t);
+  const Eigen::MatrixXd T = b(Q, QD, QDD);
+  for (int k = 0; k < batch_states; ++k)
+    agree(T.col(k), id(Q.col(k), QD.col(k), QDD.col(k)), 1e-12, "batch_rne/" + model + ": a column vs rne");
+  const Eigen::VectorXd q = Q.col(0), qd = QD.col(0), qdd = QDD.col(0);
+  add("batch_rne/" + model + "/one", [id, q, qd, qdd]() mutable {
+    opaque(q), opaque(qd), opaque(qdd);
+    auto v = id(q, qd, qdd);
+    benchmark::DoNotOptimize(v);
+  });
+  add("batch_rne/" + model + "/batch", [b, Q, QD, QDD]() mutable {
+    opaque(Q), opaque(QD), opaque(QDD);
+    auto v = b(Q, QD, QDD);
+    benchmark::DoNotOptimize(v.data());
+  });
+  const auto fd = nhdyn::aba(t);
+  const auto fb = nhdyn::forward_dynamics_batch(t);
+  const Eigen::MatrixXd A = fb(Q, QD, T);
+  for (int k = 0; k < batch_states; ++k)
+    agree(A.col(k), fd(Q.col(k), QD.col(k), T.col(k)), 1e-9, "batch_fd/" + model + ": a column vs aba");
+  const Eigen::VectorXd tau = T.col(0);
+  add("batch_fd/" + model + "/one", [fd, q, qd, tau]() mutable {
+    opaque(q), opaque(qd), opaque(tau);
+    auto v = fd(q, qd, tau);
+    benchmark::DoNotOptimize(v);
+  });
+  add("batch_fd/" + model + "/batch", [fb, Q, QD, T]() mutable {
+    opaque(Q), opaque(QD), opaque(T);
+    auto v = fb(Q, QD, T);
+    benchmark::DoNotOptimize(v.data());
+  });
+}
+
 }  // namespace
 #ifdef NHDYN_BENCH_URDF
 /// A robot file's constrained robot (a tree and one of its constraint types): the paper's
@@ -530,12 +717,35 @@ int main(int argc, char** argv) {
                                    std::pair{"mobile_manipulator_wheels", "mobile_manipulator_wheels.json"},
                                    std::pair{"mobile_manipulator_bicycle", "mobile_manipulator_bicycle.json"}}) {
     const auto r = nhdyn::io::load_robot_file(std::string(NHDYN_SOURCE_DIR "/examples/robots/") + file);
-    std::visit([&](const auto& c) { register_wheeled(name, r.model, c); }, *r.constraint);
+    std::visit([&](const auto& c) {
+      register_wheeled(name, r.model, c);
+      register_deriv_nh(name, r.model, c);
+    }, *r.constraint);
   }
 #endif
   std::mt19937_64 tree_rng(41);
+  std::vector<std::pair<std::string, nhdyn::tree<double>>> trees;
   for (int n : {12, 24, 48})  // branching trees, URDF-like (no body offsets)
-    register_tree("tree" + std::to_string(n), nhdyn_ref::random_tree(tree_rng, n, 0.4, false));
+    trees.emplace_back("tree" + std::to_string(n), nhdyn_ref::random_tree(tree_rng, n, 0.4, false));
+  for (const auto& [name, t] : trees) register_tree(name, t);
+
+  register_deriv("paper5", nhdyn::as_tree(p5));
+  register_deriv("puma560", nhdyn::as_tree(nhdyn::presets::puma560<double>()));
+#ifdef NHDYN_BENCH_URDF
+  register_deriv("mobile_manipulator", nhdyn::io::load_urdf(NHDYN_SOURCE_DIR "/examples/urdf/mobile_manipulator.urdf"));
+#endif
+  for (const auto& [name, t] : trees) register_deriv(name, t);
+  register_deriv_nh("paper5", nhdyn::as_tree(p5), ddrive_constraint<dynamic>(5));
+  register_deriv_fd("paper5", nhdyn::as_tree(p5));
+  register_deriv_fd("puma560", nhdyn::as_tree(nhdyn::presets::puma560<double>()));
+  for (const auto& [name, t] : trees) register_deriv_fd(name, t);
+  register_batch("paper5", nhdyn::as_tree(p5));
+  register_batch("puma560", nhdyn::as_tree(nhdyn::presets::puma560<double>()));
+#ifdef NHDYN_BENCH_URDF
+  register_batch("mobile_manipulator", nhdyn::io::load_urdf(NHDYN_SOURCE_DIR "/examples/urdf/mobile_manipulator.urdf"));
+#endif
+  for (const auto& [name, t] : trees) register_batch(name, t);
+  benchmark::AddCustomContext("simd_width", std::to_string(nhdyn::simd_width));
 
   benchmark::AddCustomContext("nhdyn_compiler", NHDYN_BENCH_CXX);
   benchmark::AddCustomContext("nhdyn_flags", NHDYN_BENCH_FLAGS);

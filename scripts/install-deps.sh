@@ -5,7 +5,7 @@ set -euo pipefail
 pkgs=(
   build-essential cmake g++ clang-14 libclang-rt-14-dev
   libeigen3-dev librange-v3-dev catch2 libbenchmark-dev
-  libboost-dev liborocos-kdl-dev nlohmann-json3-dev libcli11-dev
+  libboost-dev liborocos-kdl-dev nlohmann-json3-dev libcli11-dev libxsimd-dev
   liburdfdom-dev libtinyxml2-dev
   gnuplot-nox python3 python3-matplotlib
   pybind11-dev python3-dev python3-numpy python3-pytest python3-scipy

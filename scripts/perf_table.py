@@ -42,6 +42,12 @@ TARGET_TREE = 0.25
 WHEELED = [("mobile_manipulator_ddrive", 1), ("mobile_manipulator_wheels", 3), ("mobile_manipulator_bicycle", 2)]
 
 
+DERIV_MODELS = ["paper5", "puma560", "mobile_manipulator", "tree12", "tree24", "tree48"]
+DERIV_NH_MODELS = ["paper5", "mobile_manipulator_ddrive", "mobile_manipulator_wheels", "mobile_manipulator_bicycle"]
+DERIV_FD_MODELS = ["paper5", "puma560", "tree12", "tree24", "tree48"]
+TARGET_DERIV, TARGET_DERIV_NH, TARGET_DERIV_FD = 3.0, 3.5, 5.0
+BATCH_MODELS = ["paper5", "puma560", "mobile_manipulator", "tree12", "tree24", "tree48"]
+BATCH_STATES, TARGET_BATCH = 256, 2.5
 PAIRED = {}  # nh_pair/<model>/<size> → median over repetitions of time(nh) / time(rne)
 
 
@@ -275,6 +281,77 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
     out.append(f"- Target nh ≥ 20× faster than projected Euler–Lagrange: least **{least_el:.0f}×** — "
                f"{'met' if least_el >= 20 else 'NOT met'}.")
     out.append("")
+    # ---------------------------------------------------------------- derivatives (issue 18)
+    out.append("### Analytic derivatives against one call and against dual numbers (issue 18)\n")
+    out.append("`deriv_rne/<model>/{rne, analytic, dual}`: one double rne of the tree (the tree kernel, its "
+               "output allocated), the full ∂τ/∂(q, q̇) and M of `rne_derivatives` (into a reused result), "
+               "and ∂τ/∂(q, q̇) by duals through the tree kernel (`jacobian`, 8 directions a pass); "
+               "`deriv_rne_pair/<model>`: rne and analytic paired as above. `deriv_nh/<model>/{nh, analytic, "
+               "dual}`: one nonholonomic inverse dynamics on the tree, `inverse_dynamics_derivatives` "
+               "(∂τ/∂(q, η, η̇)) and `inverse_dynamics_linearizer` (duals); `deriv_nh_pair` paired. "
+               "`deriv_fd/<model>/{fd, analytic, dual}`: holonomic forward dynamics, "
+               "`forward_dynamics_derivatives` (q̈, ∂q̈/∂(q, q̇), M⁻¹) and `linearize_forward_dynamics`; "
+               "`deriv_nh_fd/...`: the constrained forward dynamics and its A, B.\n")
+    out.append("| model | rne | ∂τ/∂(q, q̇) analytic | analytic / rne | paired | dual | dual / analytic |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|")
+    worst_d = 0.0
+    for m in DERIV_MODELS:
+        r, a, d, pr = g(f"deriv_rne/{m}/rne"), g(f"deriv_rne/{m}/analytic"), g(f"deriv_rne/{m}/dual"), PAIRED.get(f"deriv_rne_pair/{m}")
+        if a is None:
+            continue
+        worst_d = max(worst_d, pr or ratio(a, r) or 0)
+        out.append(f"| {m} | {ns(r)} | {ns(a)} | {r2(ratio(a, r))} | {r2(pr)} | {ns(d)} | {r2(ratio(d, a))} |")
+    out.append("")
+    out.append(f"- Target full ∂τ/∂(q, q̇) ≤ {TARGET_DERIV}× one rne on every model (paired): worst **{worst_d:.2f}** — "
+               f"{'met' if 0 < worst_d <= TARGET_DERIV else 'NOT met'}.")
+    out.append("")
+    out.append("| model | nh | ∂τ/∂ζ analytic | analytic / nh | paired | dual | dual / analytic |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|")
+    worst_n = 0.0
+    for m in DERIV_NH_MODELS:
+        r, a, d, pr = g(f"deriv_nh/{m}/nh"), g(f"deriv_nh/{m}/analytic"), g(f"deriv_nh/{m}/dual"), PAIRED.get(f"deriv_nh_pair/{m}")
+        if a is None:
+            continue
+        worst_n = max(worst_n, pr or ratio(a, r) or 0)
+        out.append(f"| {m} | {ns(r)} | {ns(a)} | {r2(ratio(a, r))} | {r2(pr)} | {ns(d)} | {r2(ratio(d, a))} |")
+    out.append("")
+    out.append(f"- Target nonholonomic ∂τ/∂ζ ≤ {TARGET_DERIV_NH}× one nonholonomic call (paired): worst **{worst_n:.2f}** — "
+               f"{'met' if 0 < worst_n <= TARGET_DERIV_NH else 'NOT met'}.")
+    out.append("")
+    out.append("| model | forward dynamics | A, B analytic | analytic / fd | dual | dual / analytic |")
+    out.append("|---|---:|---:|---:|---:|---:|")
+    worst_f = 0.0
+    for m, key in [(m, "deriv_fd") for m in DERIV_FD_MODELS] + [(m, "deriv_nh_fd") for m in DERIV_NH_MODELS]:
+        r, a, d = g(f"{key}/{m}/fd"), g(f"{key}/{m}/analytic"), g(f"{key}/{m}/dual")
+        if a is None:
+            continue
+        worst_f = max(worst_f, ratio(a, r) or 0)
+        label = m if key == "deriv_fd" else f"{m} (constrained)"
+        out.append(f"| {label} | {ns(r)} | {ns(a)} | {r2(ratio(a, r))} | {ns(d)} | {r2(ratio(d, a))} |")
+    out.append("")
+    out.append(f"- Target A, B ≤ {TARGET_DERIV_FD}× one forward dynamics call: worst **{worst_f:.2f}** — "
+               f"{'met' if 0 < worst_f <= TARGET_DERIV_FD else 'NOT met'}.")
+    out.append("")
+    # ---------------------------------------------------------------- batches (issue 18)
+    out.append("### Many states per call: SIMD packs (issue 18)\n")
+    out.append(f"`batch_rne/<model>/{{one, batch}}`: one double rne of the tree, and `rne_batch` over "
+               f"{BATCH_STATES} states in one call on `simd_pack<{ctx.get('simd_width', '?')}>` (per state: the "
+               f"call's time / {BATCH_STATES}); `batch_fd/...`: `aba` and `forward_dynamics_batch`.\n")
+    out.append("| model | rne one state | rne per state, batched | throughput gain | aba one state | aba per state, batched | throughput gain |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|")
+    least_b = float("inf")
+    for m in BATCH_MODELS:
+        r1, rb, f1, fb = g(f"batch_rne/{m}/one"), g(f"batch_rne/{m}/batch"), g(f"batch_fd/{m}/one"), g(f"batch_fd/{m}/batch")
+        if rb is None:
+            continue
+        rb, fb = rb / BATCH_STATES, (fb / BATCH_STATES if fb else None)
+        least_b = min(least_b, ratio(r1, rb) or 0)
+        out.append(f"| {m} | {ns(r1)} | {ns(rb)} | {r2(ratio(r1, rb))} | {ns(f1)} | {ns(fb)} | {r2(ratio(f1, fb))} |")
+    out.append("")
+    if least_b < float("inf"):
+        out.append(f"- Target batched rne ≥ {TARGET_BATCH}× the one-state throughput: least **{least_b:.2f}×** — "
+                   f"{'met' if least_b >= TARGET_BATCH else 'NOT met'}.")
+        out.append("")
     out.append("![scaling](performance_scaling.png)")
     return "\n".join(out) + "\n"
 

@@ -1,11 +1,14 @@
-/// The reference derivatives of rne on trees (dynamics/reference_derivatives.hpp, issue 18's
+/// The derivatives of rne on trees: the reference (dynamics/reference_derivatives.hpp, the
 /// oracle) against forward-mode dual numbers through the fast tree kernel (a second
-/// implementation of rne, differentiated by the scalar type) and 30-digit central differences
-/// of the reference rne, on random trees (branches, revolute and prismatic joints, armature),
-/// paper5 as a tree and puma560.
+/// implementation of rne, differentiated by the scalar type) and 50-digit central differences
+/// of the reference rne; the analytic recursion (dynamics/rne_derivatives.hpp) against the
+/// reference, CRBA, the duals (with external wrenches) and, evaluated in 50 digits, the
+/// 50-digit central differences — on random trees (branches, revolute and prismatic joints,
+/// armature, massless bodies, point masses), paper5 as a tree and puma560.
 #include <catch2/catch.hpp>
 
 #include <nhdyn/dynamics/reference_derivatives.hpp>
+#include <nhdyn/dynamics/rne_derivatives.hpp>
 #include <nhdyn/nhdyn.hpp>
 #include <nhdyn/scalar/multiprecision.hpp>
 #include <random>
@@ -23,11 +26,12 @@ VectorXd random_vec(std::mt19937_64& rng, int n, double r) {
 double rel(const MatrixXd& a, const MatrixXd& b) {
   return (a - b).lpNorm<Eigen::Infinity>() / std::max(1.0, b.lpNorm<Eigen::Infinity>());
 }
-/// (∂τ/∂q, ∂τ/∂q̇) of the fast tree rne (nhdyn::rne(tree)), one dual direction at a time.
-std::pair<MatrixXd, MatrixXd> by_duals(const tree<double>& t, const VectorXd& q, const VectorXd& qd, const VectorXd& qdd) {
+/// (∂τ/∂q, ∂τ/∂q̇) of id(q, q̇, q̈) — the fast tree rne, with or without wrenches — one dual
+/// direction at a time.
+template <class F>
+std::pair<MatrixXd, MatrixXd> duals_of(const F& id, const VectorXd& q, const VectorXd& qd, const VectorXd& qdd) {
   using D = dual<double, 1>;
-  const int n = t.dof();
-  const auto id = rne(t);
+  const int n = static_cast<int>(q.size());
   MatrixXd dq(n, n), dqd(n, n);
   for (int j = 0; j < n; ++j) {
     Eigen::Matrix<D, Eigen::Dynamic, 1> Q = q.cast<D>(), QD = qd.cast<D>(), QDD = qdd.cast<D>();
@@ -38,6 +42,10 @@ std::pair<MatrixXd, MatrixXd> by_duals(const tree<double>& t, const VectorXd& q,
     for (int i = 0; i < n; ++i) dq(i, j) = a(i).derivative(0), dqd(i, j) = b(i).derivative(0);
   }
   return {dq, dqd};
+}
+std::pair<MatrixXd, MatrixXd> by_duals(const tree<double>& t, const VectorXd& q, const VectorXd& qd, const VectorXd& qdd) {
+  const auto id = rne(t);
+  return duals_of([&](const auto& x, const auto& xd, const auto& xdd) { return id(x, xd, xdd); }, q, qd, qdd);
 }
 }  // namespace
 
@@ -88,4 +96,152 @@ TEST_CASE("rne derivatives (reference): 30-digit central differences of the refe
     CHECK(rel(dq, fq) < 1e-13);
     CHECK(rel(dqd, fqd) < 1e-13);
   }
+}
+
+namespace {
+/// (∂τ/∂q, ∂τ/∂q̇) of rne(t)(q, qd, qdd, w) by duals (the wrenches' kinematics differentiated too).
+template <class W>
+std::pair<MatrixXd, MatrixXd> by_duals_with(const tree<double>& t, const W& w, const VectorXd& q, const VectorXd& qd,
+                                            const VectorXd& qdd) {
+  const auto id = rne(t);
+  return duals_of([&](const auto& x, const auto& xd, const auto& xdd) { return id(x, xd, xdd, w); }, q, qd, qdd);
+}
+/// The tree in 50 digits with its rotations and axes made exactly orthonormal there (a double
+/// rotation is orthogonal only to 1e-16, which two algorithms may read differently).
+template <class M>
+tree<M> rigid_in(const tree<double>& t) {
+  const auto orthonormal = [](mat3<M> R) {
+    using std::sqrt;
+    vec3<M> x = R.col(0), y = R.col(1);
+    x /= sqrt(x.dot(x));
+    y -= x * x.dot(y);
+    y /= sqrt(y.dot(y));
+    R << x, y, x.cross(y);
+    return R;
+  };
+  std::vector<body<M>> B;
+  for (const auto& b : t) {
+    body<M> c = b.template cast<M>();
+    c.R_PJ = orthonormal(c.R_PJ);
+    c.R_JB = orthonormal(c.R_JB);
+    using std::sqrt;
+    c.axis /= sqrt(c.axis.dot(c.axis));
+    B.push_back(c);
+  }
+  return tree<M>(std::move(B), t.gravity().template cast<M>(), t.name(), t.validation_policy());
+}
+tree<double> with_armature(const tree<double>& t, std::mt19937_64& rng) {
+  std::vector<body<double>> B(t.begin(), t.end());
+  for (auto& b : B) b.armature = nhdyn_ref::uniform(rng, 0.0, 0.5);
+  return tree<double>(std::move(B), t.gravity(), t.name());
+}
+}  // namespace
+
+TEST_CASE("rne derivatives (analytic): equal the reference, CRBA and rne on random trees of 1-48 bodies") {
+  std::mt19937_64 rng(1818);
+  double worst = 0;
+  for (int n : {1, 2, 3, 5, 8, 12, 16, 24, 48}) {
+    for (int trial = 0; trial < 3; ++trial) {
+      auto t = nhdyn_ref::random_tree(rng, n, trial == 1 ? 0.0 : 0.4, trial % 2 == 0);
+      if (trial == 2) t = with_armature(t, rng);
+      const VectorXd q = random_vec(rng, n, 2), qd = random_vec(rng, n, 2), qdd = random_vec(rng, n, 2);
+      const auto d = rne_derivatives(t)(q, qd, qdd);
+      const auto [rq, rqd] = reference::rne_derivatives(t, q, qd, qdd);
+      INFO("n = " << n << ", trial " << trial);
+      CHECK(rel(d.dq, rq) < 1e-12);
+      CHECK(rel(d.dqd, rqd) < 1e-12);
+      CHECK(rel(d.M, mass_matrix(t)(q)) < 1e-12);
+      CHECK(rel(d.tau, rne(t)(q, qd, qdd)) < 1e-12);
+      worst = std::max({worst, rel(d.dq, rq), rel(d.dqd, rqd)});
+      // gravity and velocity terms off: the reference without gravity, at q̇ = 0
+      const auto z = rne_derivatives(t, {.gravity = false, .velocity = false})(q, qd, qdd);
+      const auto [zq, zqd] = reference::rne_derivatives(t, q, VectorXd::Zero(n).eval(), qdd, false);
+      CHECK(rel(z.dq, zq) < 1e-12);
+      CHECK(z.dqd.lpNorm<Eigen::Infinity>() == 0);
+    }
+  }
+  INFO("worst relative difference " << worst);
+  CHECK(worst < 1e-12);
+  const auto p5 = presets::paper5<double>();
+  const VectorXd q = random_vec(rng, 5, 1), qd = random_vec(rng, 5, 1), qdd = random_vec(rng, 5, 1);
+  const auto c = rne_derivatives(p5.chain)(q, qd, qdd);
+  const auto [rq, rqd] = reference::rne_derivatives(as_tree(p5.chain), q, qd, qdd);
+  CHECK(rel(c.dq, rq) < 1e-13);
+  CHECK(rel(c.dqd, rqd) < 1e-13);
+  CHECK(rel(c.tau, rne(p5.chain)(q, qd, qdd)) < 1e-13);
+}
+
+TEST_CASE("rne derivatives (analytic): with external wrenches, equal the duals of rne(q, qd, qdd, w)") {
+  std::mt19937_64 rng(99);
+  for (int n : {1, 4, 9, 20}) {
+    for (int trial = 0; trial < 2; ++trial) {
+      const auto t = with_armature(nhdyn_ref::random_tree(rng, n, 0.4, trial == 0), rng);
+      std::vector<wrench<double>> ws;
+      for (int k = 0; k < 4; ++k) {
+        wrench<double> w;
+        w.body = std::uniform_int_distribution<int>(0, n)(rng);
+        w.force = random_vec(rng, 3, 20);
+        w.moment = random_vec(rng, 3, 5);
+        w.point = random_vec(rng, 3, 0.5);
+        w.frame = k % 2 ? wrench_frame::body : wrench_frame::world;
+        ws.push_back(w);
+      }
+      const auto w = external_wrenches(t, ws);
+      const VectorXd q = random_vec(rng, n, 2), qd = random_vec(rng, n, 2), qdd = random_vec(rng, n, 2);
+      const auto d = rne_derivatives(t)(q, qd, qdd, w);
+      const auto [eq, eqd] = by_duals_with(t, w, q, qd, qdd);
+      INFO("n = " << n << ", trial " << trial);
+      CHECK(rel(d.dq, eq) < 1e-12);
+      CHECK(rel(d.dqd, eqd) < 1e-12);
+      CHECK(rel(d.tau, rne(t)(q, qd, qdd, w)) < 1e-12);
+      // the wrenches change ∂τ/∂q (else this test could not tell them apart)
+      if (n >= 4) CHECK(rel(rne_derivatives(t)(q, qd, qdd).dq, eq) > 1e-6);
+    }
+  }
+}
+
+TEST_CASE("rne derivatives (analytic): in 50 digits, equal 50-digit central differences to 1e-30") {
+  using M = boost::multiprecision::cpp_bin_float_50;
+  std::mt19937_64 rng(50);
+  std::vector<tree<double>> models{as_tree(presets::paper5<double>().chain), as_tree(presets::puma560<double>()),
+                                   with_armature(nhdyn_ref::random_tree(rng, 12, 0.4, true), rng)};
+  for (const auto& t : models) {
+    const int n = t.dof();
+    const VectorXd q = random_vec(rng, n, 1.5), qd = random_vec(rng, n, 1.5), qdd = random_vec(rng, n, 1.5);
+    const Eigen::Matrix<M, Eigen::Dynamic, 1> Q = q.cast<M>(), QD = qd.cast<M>(), QDD = qdd.cast<M>();
+    const tree<M> tm = rigid_in<M>(t);
+    const auto d = rne_derivatives(tm)(Q, QD, QDD);
+    const M h("1e-17");  // truncation O(h²) ≈ 1e-34, rounding 1e-50/h ≈ 1e-33
+    double worst = 0;
+    for (int j = 0; j < n; ++j) {
+      auto Qp = Q, Qm = Q, Dp = QD, Dm = QD;
+      Qp(j) += h, Qm(j) -= h, Dp(j) += h, Dm(j) -= h;
+      const auto a = ((reference::rne(tm, Qp, QD, QDD) - reference::rne(tm, Qm, QD, QDD)) / (2 * h)).eval();
+      const auto b = ((reference::rne(tm, Q, Dp, QDD) - reference::rne(tm, Q, Dm, QDD)) / (2 * h)).eval();
+      for (int i = 0; i < n; ++i) {
+        using std::abs;
+        worst = std::max({worst, double(abs(d.dq(i, j) - a(i))), double(abs(d.dqd(i, j) - b(i)))});
+      }
+    }
+    const double scale = std::max({1.0, double(d.dq.cwiseAbs().maxCoeff()), double(d.dqd.cwiseAbs().maxCoeff())});
+    INFO(t.name() << ": largest difference " << worst << ", relative " << worst / scale);
+    CHECK(worst / scale < 1e-30);
+  }
+}
+
+TEST_CASE("rne derivatives (analytic): wrong sizes and non-finite inputs are refused by name") {
+  const auto t = as_tree(presets::puma560<double>());
+  const auto d = rne_derivatives(t);
+  const VectorXd z = VectorXd::Zero(6);
+  CHECK_THROWS_WITH(d(VectorXd::Zero(5).eval(), z, z), Catch::Contains("q"));
+  CHECK_THROWS_WITH(d(z, z, VectorXd::Zero(7).eval()), Catch::Contains("qdd"));
+  VectorXd bad = z;
+  bad(3) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(d(z, bad, z), input_error);
+  const auto w = external_wrenches(as_tree(presets::paper5<double>().chain), {});
+  CHECK_THROWS_WITH(d(z, z, z, w), Catch::Contains("external wrenches"));
+  rne_derivatives_result<double> out;
+  d.evaluate(z, z, z, out);
+  CHECK(out.dq.rows() == 6);
+  CHECK_THROWS_AS(d.evaluate(z, z, bad, out), input_error);
 }

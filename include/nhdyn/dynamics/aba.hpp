@@ -30,6 +30,7 @@
 #include <sstream>
 #include <vector>
 
+#include "../detail/attributes.hpp"
 #include "../detail/small_buffer.hpp"
 #include "../errors.hpp"
 #include "../functional/values.hpp"
@@ -118,9 +119,9 @@ void add_shifted_inertia(spatial::mat6<T>& I, const spatial::mat6<T>& J, const v
 
 /// ABA on the kernel constants (see the file comment), q̈ into qdd. `check(i, D_i, U_i, S_i)`
 /// sees every D_i before it is divided by.
-template <class T, class Q, class QD, class TAU, class QDD, class Check>
-void tree_aba_kernel(const std::vector<tree_link<T>>& L, const vec3<T>& g, const Q& q, const QD& qd, const TAU& tau,
-                     QDD& qdd, const Check& check) {
+template <class T, class LS, class Q, class QD, class TAU, class QDD, class Check>
+void tree_aba_kernel_impl(const std::vector<tree_link<LS>>& L, const vec3<T>& g, const Q& q, const QD& qd,
+                          const TAU& tau, QDD& qdd, const Check& check) {
   using spatial::vec6;
   const int n = static_cast<int>(L.size());
   small_buffer<aba_scratch<T>, dynamic> s(n);
@@ -130,7 +131,7 @@ void tree_aba_kernel(const std::vector<tree_link<T>>& L, const vec3<T>& g, const
     return S;
   };
   for (int i = 0; i < n; ++i) {  // pass 1: placements, v_i, c_i, rigid-body inertias, bias forces
-    const tree_link<T>& k = L[i];
+    const tree_link<LS>& k = L[i];
     aba_scratch<T>& b = s[i];
     mat3<T> R;
     vec3<T> p;
@@ -168,7 +169,7 @@ void tree_aba_kernel(const std::vector<tree_link<T>>& L, const vec3<T>& g, const
     b.pA << w.cross(fn) + vo.cross(ff), w.cross(ff);
   }
   for (int i = n - 1; i >= 0; --i) {  // pass 2: articulated inertias and bias forces, leaves to root
-    const tree_link<T>& k = L[i];
+    const tree_link<LS>& k = L[i];
     aba_scratch<T>& b = s[i];
     const vec3<T> z = b.R.col(2);
     const int o = k.revolute ? 0 : 3;  // S = z in the angular or the linear half
@@ -190,7 +191,7 @@ void tree_aba_kernel(const std::vector<tree_link<T>>& L, const vec3<T>& g, const
     l.pA.template tail<3>() += pa.template tail<3>();
   }
   for (int i = 0; i < n; ++i) {  // pass 3: accelerations, root to leaves
-    const tree_link<T>& k = L[i];
+    const tree_link<LS>& k = L[i];
     aba_scratch<T>& b = s[i];
     if (k.parent < 0) {  // a_0 = −a_g
       b.a << vec3<T>::Zero(), -g;
@@ -205,6 +206,23 @@ void tree_aba_kernel(const std::vector<tree_link<T>>& L, const vec3<T>& g, const
     qdd(i) = qddi;
     b.a.template segment<3>(o) += z * qddi;  // (7.44)
   }
+}
+
+/// The kernel with every call inside it inlined for the scalars of `flatten_kernels` (floating
+/// point, SIMD packs; detail/attributes.hpp), as it is for the others.
+template <class T, class LS, class Q, class QD, class TAU, class QDD, class Check>
+NHDYN_FLATTEN void tree_aba_kernel_flat(const std::vector<tree_link<LS>>& L, const vec3<T>& g, const Q& q,
+                                        const QD& qd, const TAU& tau, QDD& qdd, const Check& check) {
+  tree_aba_kernel_impl<T>(L, g, q, qd, tau, qdd, check);
+}
+/// Links in T, or in double for T a SIMD pack (constants broadcast where used).
+template <class T, class LS, class Q, class QD, class TAU, class QDD, class Check>
+void tree_aba_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, const Q& q, const QD& qd, const TAU& tau,
+                     QDD& qdd, const Check& check) {
+  if constexpr (flatten_kernels<T>)
+    tree_aba_kernel_flat<T>(L, g, q, qd, tau, qdd, check);
+  else
+    tree_aba_kernel_impl<T>(L, g, q, qd, tau, qdd, check);
 }
 
 }  // namespace detail
@@ -245,10 +263,8 @@ class aba_fn : public stage_tag {
     if constexpr (std::is_same_v<T, S>) {
       detail::tree_aba_kernel<T>(links_, g_, q, qd, tau, out, check);
     } else {
-      std::vector<detail::tree_link<T>> L;
-      L.reserve(links_.size());
-      for (const auto& k : links_) L.push_back(k.template cast<T>());
-      detail::tree_aba_kernel<T>(L, vec3<T>(g_.template cast<T>()), q, qd, tau, out, check);
+      detail::tree_aba_kernel<T>(detail::cast_links<T>(links_), vec3<T>(g_.template cast<T>()), q, qd, tau, out,
+                                 check);
     }
     detail::check_overflow(out, "aba");
     return out;

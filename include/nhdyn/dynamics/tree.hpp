@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "../detail/attributes.hpp"
 #include "../detail/ldlt.hpp"
 #include "../functional/values.hpp"
 #include "../model/tree_kernel.hpp"
@@ -25,10 +26,11 @@ namespace nhdyn {
 
 namespace detail {
 
-/// The rne recursion on a tree (links already in T), into tau.
-template <bool Gravity, bool Velocity, class T, class Q, class QD, class QDD, class Tau>
-void tree_rne_kernel(const std::vector<tree_link<T>>& L, const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd,
-                     Tau& tau) {
+/// The rne recursion on a tree, into tau: links in T, or in double for T a SIMD pack (the
+/// constants broadcast where they are used, not stored once per lane).
+template <bool Gravity, bool Velocity, class T, class LS, class Q, class QD, class QDD, class Tau>
+void tree_rne_kernel_impl(const std::vector<tree_link<LS>>& L, const vec3<T>& g, const Q& q, const QD& qd,
+                          const QDD& qdd, Tau& tau) {
   const int n = static_cast<int>(L.size());
   struct ws {
     mat3<T> R;
@@ -83,13 +85,31 @@ void tree_rne_kernel(const std::vector<tree_link<T>>& L, const vec3<T>& g, const
       const vec3<T> f = c.R * c.f;
       vec3<T> p;
       if (k.revolute)
-        p = k.p;
+        p = k.p.template cast<T>();
       else
         p = k.p + k.R.col(2) * T(q(i));
       pc.f += f;
       pc.m += c.R * c.m + p.cross(f);
     }
   }
+}
+
+/// The same with every call inside it inlined (detail/attributes.hpp) for the scalars of
+/// `flatten_kernels` (floating point, SIMD packs) — 15–20 % faster in double on this machine's
+/// g++ 12 -O3 (Eigen's small products otherwise stay calls) —, as it is for other scalars,
+/// whose code flattening would multiply.
+template <bool Gravity, bool Velocity, class T, class LS, class Q, class QD, class QDD, class Tau>
+NHDYN_FLATTEN void tree_rne_kernel_flat(const std::vector<tree_link<LS>>& L, const vec3<T>& g, const Q& q,
+                                        const QD& qd, const QDD& qdd, Tau& tau) {
+  tree_rne_kernel_impl<Gravity, Velocity, T>(L, g, q, qd, qdd, tau);
+}
+template <bool Gravity, bool Velocity, class T, class LS, class Q, class QD, class QDD, class Tau>
+void tree_rne_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd,
+                     Tau& tau) {
+  if constexpr (flatten_kernels<T>)
+    tree_rne_kernel_flat<Gravity, Velocity, T>(L, g, q, qd, qdd, tau);
+  else
+    tree_rne_kernel_impl<Gravity, Velocity, T>(L, g, q, qd, qdd, tau);
 }
 
 /// The composite-rigid-body algorithm on the kernel constants (RBDA Table 6.2 in 3-vector
@@ -187,7 +207,7 @@ class tree_rne_fn : public stage_tag {
     if constexpr (std::is_same_v<T, S>)
       run(links_);
     else
-      run(cast_links<T>());
+      run(detail::cast_links<T>(links_));
     detail::check_overflow(v, "rne");
     return v;
   }
@@ -215,13 +235,6 @@ class tree_rne_fn : public stage_tag {
   const std::vector<detail::tree_link<S>>& links() const { return links_; }
 
  private:
-  template <class T>
-  std::vector<detail::tree_link<T>> cast_links() const {
-    std::vector<detail::tree_link<T>> out;
-    out.reserve(links_.size());
-    for (const auto& k : links_) out.push_back(k.template cast<T>());
-    return out;
-  }
   std::vector<detail::tree_link<S>> links_;
   vec3<S> g_;
   int n_;
@@ -248,9 +261,7 @@ class tree_mass_matrix_fn : public stage_tag {
     if constexpr (std::is_same_v<T, S>) {
       return detail::tree_crba_kernel<T>(links_, q);
     } else {
-      std::vector<detail::tree_link<T>> L;
-      for (const auto& k : links_) L.push_back(k.template cast<T>());
-      return detail::tree_crba_kernel<T>(L, q);
+      return detail::tree_crba_kernel<T>(detail::cast_links<T>(links_), q);
     }
   }
 

@@ -88,19 +88,30 @@ std::vector<tree_link<S>> make_tree_links(const tree<S>& t) {
   return out;
 }
 
+/// The kernel constants in another scalar (a dual, an interval, a multiprecision number).
+template <class T, class S>
+std::vector<tree_link<T>> cast_links(const std::vector<tree_link<S>>& links) {
+  std::vector<tree_link<T>> out;
+  out.reserve(links.size());
+  for (const auto& k : links) out.push_back(k.template cast<T>());
+  return out;
+}
+
 /// (R, p) of K_i(q) in K_λ: R·Rz(q) and p for a revolute joint, R and p + R z q for a prismatic.
-template <class T>
-void kernel_placement(const tree_link<T>& k, const T& qi, mat3<T>& R, vec3<T>& p) {
+/// The link's constants may be in another scalar than q (a SIMD pack's states on double
+/// constants: scalar/simd.hpp), which the products broadcast.
+template <class T, class LS>
+void kernel_placement(const tree_link<LS>& k, const T& qi, mat3<T>& R, vec3<T>& p) {
   if (k.revolute) {
     using std::cos;
     using std::sin;
     const T c = cos(qi), s = sin(qi);
     R.col(0) = c * k.R.col(0) + s * k.R.col(1);
     R.col(1) = c * k.R.col(1) - s * k.R.col(0);
-    R.col(2) = k.R.col(2);
-    p = k.p;
+    R.col(2) = k.R.col(2).template cast<T>();
+    p = k.p.template cast<T>();
   } else {
-    R = k.R;
+    R = k.R.template cast<T>();
     p = k.p + k.R.col(2) * qi;
   }
 }

@@ -76,6 +76,13 @@ concept scalar = std::copyable<S> && std::constructible_from<S, double> && !std:
                    { is_finite_scalar(a) } -> std::convertible_to<bool>;
                  };
 
+/// Whether kernels inline every call they make for this scalar (detail/attributes.hpp's
+/// NHDYN_FLATTEN): the built-in floating-point types and SIMD packs (scalar/simd.hpp), whose
+/// operations are a few instructions each; not duals, intervals or multiprecision numbers,
+/// whose code flattening would multiply.
+template <class S>
+inline constexpr bool flatten_kernels = std::is_floating_point_v<S>;
+
 /// The scalar of a computation that mixes a model scalar M with a state scalar X
 /// (double model with dual state gives dual; interval model with double state gives
 /// interval): the one the other converts to.

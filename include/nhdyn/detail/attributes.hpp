@@ -1,0 +1,12 @@
+#pragma once
+/// \file detail/attributes.hpp
+/// Compiler attributes the kernels use, empty where the compiler has none.
+
+/// Inline every call made inside the function (GCC, Clang): for a kernel built of many small
+/// Eigen products that the compiler would otherwise leave as calls. Define NHDYN_NO_FLATTEN to
+/// turn it off (the results are the same; the test programs do, for their compile time).
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(NHDYN_NO_FLATTEN)
+#define NHDYN_FLATTEN __attribute__((flatten))
+#else
+#define NHDYN_FLATTEN
+#endif

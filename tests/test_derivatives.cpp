@@ -1,0 +1,154 @@
+/// Analytic derivatives of the nonholonomic inverse dynamics and of the forward dynamics
+/// (analysis/derivatives.hpp) against the dual-number linearizers (analysis/linearize.hpp: the
+/// same matrices by forward-mode duals through the whole pipeline) and 50-digit central
+/// differences, on paper5 as a tree, the shipped mobile manipulator with each constraint type
+/// of its robot files (differential drive, rolling wheels, bicycle), a user constraint with its
+/// own input map, a holonomic arm and random trees, with external wrenches.
+#include <catch2/catch.hpp>
+
+#include <nhdyn/analysis/derivatives.hpp>
+#include <nhdyn/io/robot_file.hpp>
+#include <nhdyn/nhdyn.hpp>
+#include <nhdyn/scalar/multiprecision.hpp>
+#include <random>
+
+#include "reference/random_tree.hpp"
+
+using namespace nhdyn;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+namespace {
+std::string source(const std::string& rel) { return std::string(NHDYN_SOURCE_DIR) + "/" + rel; }
+VectorXd random_vec(std::mt19937_64& rng, int n, double r) {
+  return VectorXd::NullaryExpr(n, [&] { return nhdyn_ref::uniform(rng, -r, r); });
+}
+double rel(const MatrixXd& a, const MatrixXd& b) {
+  return (a - b).lpNorm<Eigen::Infinity>() / std::max(1.0, b.lpNorm<Eigen::Infinity>());
+}
+
+/// Checks the analytic ∂τ/∂ζ against the dual linearizer and τ against inverse_dynamics, and
+/// the analytic A, B against the dual forward_dynamics_linearizer, at a random state.
+template <class C>
+void check_nh(const tree<double>& t, const C& c, std::mt19937_64& rng, const std::string& what) {
+  const int n = c.dof(), m = c.m();
+  const VectorXd q = random_vec(rng, n, 1.5), eta = random_vec(rng, m, 1), eta_dot = random_vec(rng, m, 1);
+  const auto d = inverse_dynamics_derivatives(t, c)(q, eta, eta_dot);
+  const auto ref = inverse_dynamics_linearizer(t, c)(q, eta, eta_dot);
+  INFO(what);
+  CHECK(rel(d.J(), ref.J) < 1e-12);
+  CHECK(rel(d.tau, inverse_dynamics(t, c)(q, eta, eta_dot)) < 1e-13);
+  const VectorXd tau = random_vec(rng, m, 5);
+  const auto a = forward_dynamics_derivatives(t, c)(q, eta, tau);
+  const auto b = forward_dynamics_linearizer(t, c)(q, eta, tau);
+  CHECK(rel(a.ss.A, b.A) < 1e-10);
+  CHECK(rel(a.ss.B, b.B) < 1e-10);
+  CHECK(rel(a.eta_dot, nh_forward_dynamics(t, c)(q, eta, tau)) < 1e-13);
+}
+}  // namespace
+
+TEST_CASE("nh derivatives: equal the dual linearizers on paper5, the mobile manipulator's constraints and a user constraint") {
+  std::mt19937_64 rng(18);
+  const auto p5 = as_tree(presets::paper5<double>().chain);
+  const differential_drive<double, dynamic> dd(5, 0, 1, 2, 0.0, -1.0);  // paper5's, sized at run time
+  for (int k = 0; k < 3; ++k) check_nh(p5, dd, rng, "paper5");
+  for (const char* file : {"mobile_manipulator.json", "mobile_manipulator_wheels.json", "mobile_manipulator_bicycle.json"}) {
+    const auto r = io::load_robot_file(source("examples/robots/") + file);
+    REQUIRE(r.constraint);
+    std::visit([&](const auto& c) {
+      for (int k = 0; k < 2; ++k) check_nh(r.model, c, rng, file);
+    }, *r.constraint);
+  }
+  // a user constraint (paper5's, given as functions) with an input map E = S·diag(2, 1): SᵀE ≠ I
+  const auto user = make_constraint(
+      5, 1, [dd](const auto& q) { return dd.A(q); }, [dd](const auto& q) { return dd.S(q); }, nullptr,
+      [dd](const auto& q) {
+        using T = typename std::decay_t<decltype(q)>::Scalar;
+        auto E = dd.S(q).eval();
+        E.col(0) *= T(2);
+        return Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>(E);
+      });
+  check_nh(p5, user, rng, "user constraint with E");
+  // holonomic: the derivatives of rne itself
+  const auto puma = as_tree(presets::puma560<double>());
+  check_nh(puma, holonomic<dynamic>{6}, rng, "puma560, holonomic");
+}
+
+TEST_CASE("nh derivatives: in 50 digits, equal 50-digit central differences of inverse_dynamics") {
+  using M = boost::multiprecision::cpp_bin_float_50;
+  using VM = Eigen::Matrix<M, Eigen::Dynamic, 1>;
+  std::mt19937_64 rng(50);
+  const auto r = io::load_robot_file(source("examples/robots/mobile_manipulator_wheels.json"));
+  std::visit([&](const auto& c) {
+    const int n = c.dof(), m = c.m();
+    const VM q = random_vec(rng, n, 1.5).cast<M>(), eta = random_vec(rng, m, 1).cast<M>(),
+             eta_dot = random_vec(rng, m, 1).cast<M>();
+    const auto d = inverse_dynamics_derivatives(r.model, c)(q, eta, eta_dot);
+    const auto id = inverse_dynamics(r.model, c);
+    const M h("1e-17");
+    double worst = 0, scale = 1;
+    const auto J = d.J();
+    for (int j = 0; j < n + 2 * m; ++j) {
+      VM z(n + 2 * m);
+      z << q, eta, eta_dot;
+      VM zp = z, zm = z;
+      zp(j) += h, zm(j) -= h;
+      const auto f = [&](const VM& x) { return VM(id(VM(x.head(n)), VM(x.segment(n, m)), VM(x.tail(m)))); };
+      const VM col = (f(zp) - f(zm)) / (2 * h);
+      for (int i = 0; i < m; ++i) {
+        using std::abs;
+        worst = std::max(worst, double(abs(J(i, j) - col(i))));
+        scale = std::max(scale, double(abs(col(i))));
+      }
+    }
+    INFO("largest difference " << worst << ", scale " << scale);
+    CHECK(worst / scale < 1e-28);
+  }, *r.constraint);
+}
+
+TEST_CASE("forward dynamics derivatives (holonomic): equal the duals, with armature and external wrenches") {
+  std::mt19937_64 rng(7);
+  for (int n : {1, 3, 7, 16, 30}) {
+    std::vector<body<double>> B;
+    for (const auto& b : nhdyn_ref::random_tree(rng, n, 0.4, n % 2 == 1)) B.push_back(b);
+    for (auto& b : B) b.armature = nhdyn_ref::uniform(rng, 0.0, 0.3);
+    const tree<double> t(std::move(B), vec3<double>(0, 0, -9.81), "random tree");
+    const VectorXd q = random_vec(rng, n, 2), qd = random_vec(rng, n, 2), tau = random_vec(rng, n, 10);
+    const auto a = forward_dynamics_derivatives(t)(q, qd, tau);
+    const auto b = linearize_forward_dynamics(t, q, qd, tau);
+    const auto s = a.state_space_model();
+    INFO("n = " << n);
+    CHECK(rel(s.A, b.A) < 1e-10);
+    CHECK(rel(s.B, b.B) < 1e-10);
+    CHECK(rel(a.qdd, forward_dynamics(t)(q, qd, tau)) < 1e-12);
+    // with wrenches: the duals of forward_dynamics(q, qd, tau, w)
+    wrench<double> w1, w2;
+    w1.body = n, w1.force = random_vec(rng, 3, 20), w1.point = random_vec(rng, 3, 0.3);
+    w2.body = 1, w2.moment = random_vec(rng, 3, 5), w2.frame = wrench_frame::body;
+    const auto w = external_wrenches(t, {w1, w2});
+    const auto aw = forward_dynamics_derivatives(t)(q, qd, tau, w);
+    const auto fd = forward_dynamics(t);
+    VectorXd x(3 * n);
+    x << q, qd, tau;
+    const MatrixXd Jw = jacobian(
+        [&](const auto& z) {
+          using D = typename std::decay_t<decltype(z)>::Scalar;
+          return Eigen::Matrix<D, Eigen::Dynamic, 1>(fd(z.head(n), z.segment(n, n), z.tail(n), w));
+        },
+        x);
+    CHECK(rel(aw.dq, Jw.leftCols(n)) < 1e-10);
+    CHECK(rel(aw.dqd, Jw.middleCols(n, n)) < 1e-10);
+    CHECK(rel(aw.Minv, Jw.rightCols(n)) < 1e-10);
+  }
+}
+
+TEST_CASE("derivatives: a constraint for another model, and bad inputs, are refused by name") {
+  const auto p5 = as_tree(presets::paper5<double>().chain);
+  CHECK_THROWS_WITH(inverse_dynamics_derivatives(p5, holonomic<dynamic>{4}), Catch::Contains("4 joints"));
+  const auto d = inverse_dynamics_derivatives(p5, differential_drive<double, dynamic>(5, 0, 1, 2, 0.0, -1.0));
+  const VectorXd z4 = VectorXd::Zero(4), z3 = VectorXd::Zero(3);
+  CHECK_THROWS_WITH(d(VectorXd::Zero(5).eval(), z3, z4), Catch::Contains("eta"));
+  VectorXd q = VectorXd::Zero(5);
+  q(2) = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_AS(d(q, z4, z4), input_error);
+}
