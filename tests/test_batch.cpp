@@ -112,6 +112,18 @@ TEST_CASE("batches: wrong sizes, a non-finite column and a singular model are re
   CHECK_THROWS_WITH(forward_dynamics_batch(t)(Z, bad, Z), Catch::Contains("column) 3"));
   const differential_drive<double, dynamic> dd(5, 0, 1, 2, 0.0, -1.0);
   CHECK_THROWS_WITH(inverse_dynamics_batch(t, dd), Catch::Contains("5 joints"));
+  // the constraint's own error in one state names that state: E = q₃·S makes SᵀE singular at q₃ = 0
+  const auto scaled = make_constraint(
+      5, 1, [dd](const auto& q) { return dd.A(q); }, [dd](const auto& q) { return dd.S(q); }, nullptr,
+      [dd](const auto& q) {
+        using T = typename std::decay_t<decltype(q)>::Scalar;
+        return Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>(dd.S(q) * q(3));
+      });
+  const auto p5 = as_tree(presets::paper5<double>().chain);
+  MatrixXd Q5 = MatrixXd::Constant(5, 4, 0.5);
+  Q5(3, 2) = 0;
+  CHECK_THROWS_WITH(inverse_dynamics_batch(p5, scaled)(Q5, MatrixXd::Zero(4, 4).eval(), MatrixXd::Zero(4, 4).eval()),
+                    Catch::Contains("state (column) 2") && Catch::Contains("SᵀE"));
   // a massless leaf: nothing with inertia moves with its joint
   std::vector<body<double>> B(t.begin(), t.end());
   B.back().mass = 0;

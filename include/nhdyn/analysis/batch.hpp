@@ -16,6 +16,7 @@
 /// from libm's in the last bit: tests/test_batch.cpp, ≤ 1e-13 relative).
 #include <Eigen/Core>
 #include <array>
+#include <exception>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -25,30 +26,30 @@
 #include "../constraints/stages.hpp"
 #include "../dynamics/aba.hpp"
 #include "../dynamics/tree.hpp"
+#include "../model/chain.hpp"
 #include "../scalar/simd.hpp"
 
 namespace nhdyn {
 
 namespace detail {
-/// Whether every entry is finite: one pass that the compiler vectorises (x·0 is 0 for a
-/// finite x and NaN for an infinite or NaN one).
+/// Whether every entry is finite: detail::finite_range column by column (one pass the compiler
+/// vectorises; the exponent bits under -ffast-math).
 template <class X>
 bool all_finite(const X& x) {
-  double s = 0;
   for (Eigen::Index k = 0; k < x.cols(); ++k)
-    for (Eigen::Index i = 0; i < x.rows(); ++i) s += double(x(i, k)) * 0.0;
-  return s == 0;
+    if (!finite_range(x.col(k), 0, x.rows())) return false;
+  return true;
 }
 /// Sizes (rows × same K) and finiteness of a batch argument, naming the first bad column.
 template <class X>
-void check_batch(const Eigen::MatrixBase<X>& x, int rows, Eigen::Index cols, const char* what) {
+void check_batch(const Eigen::MatrixBase<X>& x, int rows, Eigen::Index cols, const char* what, bool finite = true) {
   if (x.rows() != rows || x.cols() != cols) {
     std::ostringstream os;
     os << "batch argument " << what << " is " << x.rows() << " × " << x.cols() << ", expected " << rows << " × "
        << cols << " (one column per state)";
     throw input_error(os.str());
   }
-  if (all_finite(x)) return;
+  if (!finite || all_finite(x)) return;
   for (Eigen::Index k = 0; k < x.cols(); ++k)
     for (Eigen::Index i = 0; i < x.rows(); ++i)
       if (!std::isfinite(double(x(i, k)))) {
@@ -89,10 +90,10 @@ void check_batch_result(const Y& y, const char* what) {
 /// returns the results' columns, checked finite.
 template <int W, class A, class B, class C, class F>
 Eigen::MatrixXd in_packs(int n, const A& a, const B& b, const C& c, const std::array<const char*, 3>& names,
-                         const char* what, F&& f) {
+                         const char* what, F&& f, bool b_finite = true) {
   const Eigen::Index K = a.cols();
   check_batch(a, n, K, names[0]);
-  check_batch(b, n, K, names[1]);
+  check_batch(b, n, K, names[1], b_finite);
   check_batch(c, n, K, names[2]);
   Eigen::MatrixXd out(n, K);
   Eigen::Matrix<simd_pack<W>, Eigen::Dynamic, 1> pa(n), pb(n), pc(n), r(n);
@@ -108,10 +109,12 @@ Eigen::MatrixXd in_packs(int n, const A& a, const B& b, const C& c, const std::a
 }
 }  // namespace detail
 
-/// τ of many states of a tree (see the file comment).
+/// τ of many states of a tree (see the file comment). W: the lanes per evaluation (a template
+/// parameter, so that translation units built for different targets define different types).
+template <int W = simd_width>
 class rne_batch_fn {
  public:
-  static constexpr int width = simd_width;
+  static constexpr int width = W;
   using pack = simd_pack<width>;
 
   explicit rne_batch_fn(const tree<double>& t, rne_options o = {})
@@ -125,7 +128,8 @@ class rne_batch_fn {
     return detail::in_packs<width>(n_, Q_, QD_, QDD_, {"Q", "QD", "QDD"}, "rne_batch",
                                    [&](Eigen::Index, const auto& q, const auto& qd, const auto& qdd, auto& tau) {
                                      run(g, q, qd, qdd, tau);
-                                   });
+                                   },
+                                   opt_.velocity);  // without velocity terms q̇ is not read (as rne)
   }
 
  private:
@@ -144,10 +148,10 @@ class rne_batch_fn {
   rne_options opt_;
 };
 
-inline rne_batch_fn rne_batch(const tree<double>& t, rne_options o = {}) { return rne_batch_fn(t, o); }
+inline rne_batch_fn<> rne_batch(const tree<double>& t, rne_options o = {}) { return rne_batch_fn<>(t, o); }
 template <int N>
-rne_batch_fn rne_batch(const chain<double, N>& c, rne_options o = {}) {
-  return rne_batch_fn(as_tree(c), o);
+rne_batch_fn<> rne_batch(const chain<double, N>& c, rne_options o = {}) {
+  return rne_batch_fn<>(as_tree(c), o);
 }
 
 /// The nonholonomic inverse dynamics of many states (see the file comment).
@@ -172,26 +176,43 @@ class inverse_dynamics_batch_fn {
     Eigen::MatrixXd QD(n, K), QDD(n, K), out(m, K);
     vecN<double, C::n_at_compile_time> q(n);
     vecN<double, C::m_at_compile_time> e(m), ed(m);
+    const auto at = [](Eigen::Index k, const std::exception& e) {
+      return "inverse_dynamics_batch: state (column) " + std::to_string(k) + ": " + e.what();
+    };
     for (Eigen::Index k = 0; k < K; ++k) {  // the lift, state by state
       q = Q_.col(k);
       e = ETA.col(k);
       ed = ETA_DOT.col(k);
-      const auto xi = lift_(q, e, ed);
-      QD.col(k) = xi.qd;
-      QDD.col(k) = xi.qdd;
+      try {
+        const auto xi = lift_(q, e, ed);
+        QD.col(k) = xi.qd;
+        QDD.col(k) = xi.qdd;
+        if (!detail::finite_range(QD.col(k), 0, n) || !detail::finite_range(QDD.col(k), 0, n))
+          throw numerical_error("the lifted q̇ or q̈ is not finite although every input is (overflow)");
+      } catch (const input_error& x) {
+        throw input_error(at(k, x));
+      } catch (const numerical_error& x) {
+        throw numerical_error(at(k, x));
+      }
     }
     const Eigen::MatrixXd V = rne_(Q_, QD, QDD);
     vecN<double, C::n_at_compile_time> v(n);
     for (Eigen::Index k = 0; k < K; ++k) {  // the projection, state by state
       q = Q_.col(k);
       v = V.col(k);
-      out.col(k) = project_(q, v);
+      try {
+        out.col(k) = project_(q, v);
+      } catch (const input_error& x) {
+        throw input_error(at(k, x));
+      } catch (const numerical_error& x) {
+        throw numerical_error(at(k, x));
+      }
     }
     return out;
   }
 
  private:
-  rne_batch_fn rne_;
+  rne_batch_fn<> rne_;
   lift_fn<C> lift_;
   project_fn<C> project_;
   C c_;
@@ -204,9 +225,10 @@ inverse_dynamics_batch_fn<C> inverse_dynamics_batch(const tree<double>& t, const
 }
 
 /// q̈ of many states by the articulated-body algorithm in packs (see the file comment).
+template <int W = simd_width>
 class forward_dynamics_batch_fn {
  public:
-  static constexpr int width = simd_width;
+  static constexpr int width = W;
   using pack = simd_pack<width>;
 
   explicit forward_dynamics_batch_fn(const tree<double>& t)
@@ -250,6 +272,8 @@ class forward_dynamics_batch_fn {
   std::vector<std::string> joints_;
 };
 
-inline forward_dynamics_batch_fn forward_dynamics_batch(const tree<double>& t) { return forward_dynamics_batch_fn(t); }
+inline forward_dynamics_batch_fn<> forward_dynamics_batch(const tree<double>& t) {
+  return forward_dynamics_batch_fn<>(t);
+}
 
 }  // namespace nhdyn

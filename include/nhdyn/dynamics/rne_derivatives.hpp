@@ -189,15 +189,7 @@ void tree_rne_derivatives_kernel(const std::vector<tree_link<T>>& L, const vec3<
     // for the rows of i's ancestors: + S_i ×* F_i
     dFqn += b.Sw.cross(b.Fn) + b.Sv.cross(b.Ff);
     dFqf += b.Sw.cross(b.Ff);
-    // the pairs (i, ancestor j): one 18-vector per j, [S_j, dA_j, dV_j], against per-i weights
-    using vec18 = Eigen::Matrix<T, 18, 1>;
-    vec18 wq, wqd, wiq, wiqd, wM;  // → ∂τ_j/∂q_i, ∂τ_j/∂q̇_i, ∂τ_i/∂q_j, ∂τ_i/∂q̇_j, M_ij
-    wq << dFqn, dFqf, vec3<T>::Zero(), vec3<T>::Zero(), vec3<T>::Zero(), vec3<T>::Zero();
-    wqd << dFvn, dFvf, vec3<T>::Zero(), vec3<T>::Zero(), vec3<T>::Zero(), vec3<T>::Zero();
-    wiq << vec3<T>::Zero(), vec3<T>::Zero(), u1w, u1v, u2, vec3<T>::Zero();
-    wiqd << u2, vec3<T>::Zero(), vec3<T>::Zero(), vec3<T>::Zero(), T(2) * u1w, T(2) * u1v;
-    wM << u1w, u1v, vec3<T>::Zero(), vec3<T>::Zero(), vec3<T>::Zero(), vec3<T>::Zero();
-    if (b.has_G) wiq.template head<3>() -= u3;
+    // the pairs (i, ancestor j): five dot products each
     for (int j = k.parent; j >= 0; j = L[j].parent) {
       const rne_deriv_scratch<T>& c = s[j];
       out.dq(j, i) = dot(c.Sw, c.Sv, dFqn, dFqf);
@@ -305,7 +297,9 @@ class rne_derivatives_fn {
     return run(q, qd, qdd, &w.wrenches());
   }
 
-  /// Into a result whose matrices are reused (no allocation after the first call of a size).
+  /// Into a result whose matrices are reused: no allocation after the first call of a size, for
+  /// trees of up to 32 bodies (the scratch then lives on the stack). `out` must not alias the
+  /// inputs.
   template <class Q, class QD, class QDD>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
                 rne_derivatives_result<S>& out) const {
@@ -315,10 +309,16 @@ class rne_derivatives_fn {
       detail::rne_derivatives_dispatch<S>(links_, g_, opt_.gravity, q, qd, qdd, fx, out);
     else
       detail::rne_derivatives_dispatch<S>(links_, g_, opt_.gravity, q, vecN<S, dynamic>::Zero(n_), qdd, fx, out);
-    detail::check_overflow(out.tau, "rne_derivatives");
+    check_result(out);
   }
 
  private:
+  template <class T>
+  static void check_result(const rne_derivatives_result<T>& out) {
+    detail::check_overflow(out.tau, "rne_derivatives");
+    for (const auto* m : {&out.dq, &out.dqd, &out.M})
+      for (Eigen::Index c = 0; c < m->cols(); ++c) detail::check_overflow(m->col(c), "rne_derivatives (a derivative)");
+  }
   template <class Q, class QD, class QDD>
   void check(const Q& q, const QD& qd, const QDD& qdd) const {
     detail::check_size(q, n_, "q");
@@ -350,7 +350,7 @@ class rne_derivatives_fn {
     } else {
       go(detail::cast_links<T>(links_));
     }
-    detail::check_overflow(out.tau, "rne_derivatives");
+    check_result(out);
     return out;
   }
 

@@ -5,15 +5,16 @@
 /// lane on a fixed-size array (the compiler vectorises it: -O3 -march=native gives one AVX2 or
 /// AVX-512 instruction per operation); sin, cos and sqrt go through xsimd's vectorised
 /// functions (Debian's libxsimd-dev, header-only) when the target has a batch of W doubles,
-/// and lane by lane through libm otherwise. `simd_width` is the target's native width (8 with
-/// AVX-512, 4 with AVX2, 2 with SSE2).
+/// and lane by lane through libm otherwise. `simd_width` is the target's native width with
+/// xsimd (8 with AVX-512, 4 with AVX2, 2 with SSE2), 4 without it, or -DNHDYN_SIMD_WIDTH=W.
 ///
 /// What it is for: evaluating many states of a computation that does not branch on the
-/// values it computes — rne, and the batch entry points of dynamics/batch_dynamics.hpp. The
+/// values it computes — rne, and the batch entry points of analysis/batch.hpp. The
 /// library looks at a scalar's value only through value_of (lane 0 here), is_exact_zero and
 /// is_finite_scalar (every lane); a check made on value_of sees lane 0 alone, so the batch
 /// entry points run every check that reads a state's values in double, state by state.
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -41,7 +42,13 @@ struct simd_pack {
   static_assert(W >= 1 && W <= 16, "simd_pack: 1 to 16 lanes");
   static constexpr int lanes = W;
   /// Uninitialised by default, as a double is (Eigen's temporaries are not zeroed either).
-  alignas(sizeof(double) * (W >= 8 ? 8 : W >= 4 ? 4 : W >= 2 ? 2 : 1)) std::array<double, W> v;
+  /// Aligned to the pack's size, at most to what Eigen's heap storage guarantees
+  /// (EIGEN_MAX_ALIGN_BYTES: 16 with SSE2, 32 AVX, 64 AVX-512), so a vector of packs is never
+  /// under-aligned.
+  static constexpr std::size_t alignment = std::max<std::size_t>(
+      alignof(double), std::min<std::size_t>(sizeof(double) * (W >= 8 ? 8 : W >= 4 ? 4 : W >= 2 ? 2 : 1),
+                                             std::size_t(EIGEN_MAX_ALIGN_BYTES)));
+  alignas(alignment) std::array<double, W> v;
 
   simd_pack() = default;
   simd_pack(double x) { v.fill(x); }  // NOLINT: a double is every lane (as a dual's value)
