@@ -486,7 +486,8 @@ void register_deriv(const std::string& model, const nhdyn::tree<double>& t) {
 }
 
 /// deriv_fd/<model>/{fd, analytic, dual}: one holonomic forward dynamics call, its analytic
-/// A, B (forward_dynamics_derivatives: q̈, ∂q̈/∂(q, q̇), M⁻¹) and the same by duals
+/// A, B (forward_dynamics_derivatives: q̈, ∂q̈/∂(q, q̇), M⁻¹; `evaluate` into a reused result,
+/// as deriv_rne's analytic) and the same by duals
 /// (linearize_forward_dynamics, 3n directions).
 void register_deriv_fd(const std::string& model, const nhdyn::tree<double>& t) {
   const int n = t.dof();
@@ -504,10 +505,10 @@ void register_deriv_fd(const std::string& model, const nhdyn::tree<double>& t) {
     auto r = fd(s.q, s.qd, tau);
     benchmark::DoNotOptimize(r);
   });
-  add("deriv_fd/" + model + "/analytic", [d, s, tau]() mutable {
+  add("deriv_fd/" + model + "/analytic", [d, s, tau, out = a]() mutable {  // into a reused result
     opaque(s.q), opaque(s.qd), opaque(tau);
-    auto r = d(s.q, s.qd, tau);
-    benchmark::DoNotOptimize(r.dq.data());
+    d.evaluate(s.q, s.qd, tau, out);
+    benchmark::DoNotOptimize(out.dq.data());
   });
   add("deriv_fd/" + model + "/dual", [t, s, tau]() mutable {
     opaque(s.q), opaque(s.qd), opaque(tau);
@@ -517,7 +518,7 @@ void register_deriv_fd(const std::string& model, const nhdyn::tree<double>& t) {
 }
 
 /// deriv_nh/<model>/{nh, analytic, dual}: one nonholonomic inverse dynamics call, its analytic
-/// ∂τ/∂(q, η, η̇) (inverse_dynamics_derivatives) and the same by duals
+/// ∂τ/∂(q, η, η̇) (inverse_dynamics_derivatives, `evaluate` into a reused result) and the same by duals
 /// (inverse_dynamics_linearizer, built once); deriv_nh_pair/<model>: nh and analytic paired;
 /// deriv_nh_fd/<model>/{fd, analytic, dual}: the constrained forward dynamics and its A, B.
 template <class C>
@@ -540,10 +541,10 @@ void register_deriv_nh(const std::string& model, const nhdyn::tree<double>& t, c
     auto r = id(q, eta, eta_dot);
     benchmark::DoNotOptimize(r);
   };
-  const auto analytic_call = [d, q, eta, eta_dot]() mutable {
+  const auto analytic_call = [d, q, eta, eta_dot, out = d(q, eta, eta_dot)]() mutable {  // into a reused result
     opaque(q), opaque(eta), opaque(eta_dot);
-    auto r = d(q, eta, eta_dot);
-    benchmark::DoNotOptimize(r.dq.data());
+    d.evaluate(q, eta, eta_dot, out);
+    benchmark::DoNotOptimize(out.dq.data());
   };
   add("deriv_nh/" + model + "/nh", nh_call);
   add("deriv_nh/" + model + "/analytic", analytic_call);
@@ -566,10 +567,10 @@ void register_deriv_nh(const std::string& model, const nhdyn::tree<double>& t, c
     auto r = fd(q, eta, tau);
     benchmark::DoNotOptimize(r);
   });
-  add("deriv_nh_fd/" + model + "/analytic", [fdd, q, eta, tau]() mutable {
+  add("deriv_nh_fd/" + model + "/analytic", [fdd, q, eta, tau, out = fdd(q, eta, tau)]() mutable {  // reused result
     opaque(q), opaque(eta), opaque(tau);
-    auto r = fdd(q, eta, tau);
-    benchmark::DoNotOptimize(r.ss.A.data());
+    fdd.evaluate(q, eta, tau, out);
+    benchmark::DoNotOptimize(out.ss.A.data());
   });
   add("deriv_nh_fd/" + model + "/dual", [fdl, q, eta, tau]() mutable {
     opaque(q), opaque(eta), opaque(tau);

@@ -288,10 +288,11 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
                "and ∂τ/∂(q, q̇) by duals through the tree kernel (`jacobian`, 8 directions a pass); "
                "`deriv_rne_pair/<model>`: rne and analytic paired as above. `deriv_nh/<model>/{nh, analytic, "
                "dual}`: one nonholonomic inverse dynamics on the tree, `inverse_dynamics_derivatives` "
-               "(∂τ/∂(q, η, η̇)) and `inverse_dynamics_linearizer` (duals); `deriv_nh_pair` paired. "
-               "`deriv_fd/<model>/{fd, analytic, dual}`: holonomic forward dynamics, "
-               "`forward_dynamics_derivatives` (q̈, ∂q̈/∂(q, q̇), M⁻¹) and `linearize_forward_dynamics`; "
-               "`deriv_nh_fd/...`: the constrained forward dynamics and its A, B.\n")
+               "(∂τ/∂(q, η, η̇), `evaluate` into a reused result) and `inverse_dynamics_linearizer` (duals); "
+               "`deriv_nh_pair` paired. `deriv_fd/<model>/{fd, analytic, dual}`: holonomic forward dynamics, "
+               "`forward_dynamics_derivatives` (q̈, ∂q̈/∂(q, q̇), M⁻¹; `evaluate` into a reused result) and "
+               "`linearize_forward_dynamics`; `deriv_nh_fd/...`: the constrained forward dynamics and its A, B "
+               "(`evaluate`).\n")
     out.append("| model | rne | ∂τ/∂(q, q̇) analytic | analytic / rne | paired | dual | dual / analytic |")
     out.append("|---|---:|---:|---:|---:|---:|---:|")
     worst_d = 0.0

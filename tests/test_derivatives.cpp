@@ -44,6 +44,19 @@ void check_nh(const tree<double>& t, const C& c, std::mt19937_64& rng, const std
   CHECK(rel(a.ss.A, b.A) < 1e-10);
   CHECK(rel(a.ss.B, b.B) < 1e-10);
   CHECK(rel(a.eta_dot, nh_forward_dynamics(t, c)(q, eta, tau)) < 1e-13);
+  // evaluate into a result that held another state: the same numbers as the call
+  nh_derivatives_result<double, C::m_at_compile_time> e;
+  nh_fd_derivatives_result<double, C::m_at_compile_time> ef;
+  inverse_dynamics_derivatives(t, c).evaluate(VectorXd(2 * q), eta_dot, tau, e);
+  forward_dynamics_derivatives(t, c).evaluate(VectorXd(2 * q), eta_dot, tau, ef);
+  inverse_dynamics_derivatives(t, c).evaluate(q, eta, eta_dot, e);
+  forward_dynamics_derivatives(t, c).evaluate(q, eta, tau, ef);
+  CHECK(e.J() == d.J());
+  CHECK(e.tau == d.tau);
+  CHECK(e.dqd_dq == d.dqd_dq);
+  CHECK(ef.ss.A == a.ss.A);
+  CHECK(ef.ss.B == a.ss.B);
+  CHECK(ef.eta_dot == a.eta_dot);
 }
 }  // namespace
 
@@ -108,7 +121,8 @@ TEST_CASE("nh derivatives: in 50 digits, equal 50-digit central differences of i
 
 TEST_CASE("forward dynamics derivatives (holonomic): equal the duals, with armature and external wrenches") {
   std::mt19937_64 rng(7);
-  for (int n : {1, 3, 7, 16, 30}) {
+  fd_derivatives_result<double> reused;
+  for (int n : {30, 1, 3, 7, 16}) {
     std::vector<body<double>> B;
     for (const auto& b : nhdyn_ref::random_tree(rng, n, 0.4, n % 2 == 1)) B.push_back(b);
     for (auto& b : B) b.armature = nhdyn_ref::uniform(rng, 0.0, 0.3);
@@ -121,6 +135,13 @@ TEST_CASE("forward dynamics derivatives (holonomic): equal the duals, with armat
     CHECK(rel(s.A, b.A) < 1e-10);
     CHECK(rel(s.B, b.B) < 1e-10);
     CHECK(rel(a.qdd, forward_dynamics(t)(q, qd, tau)) < 1e-12);
+    // evaluate into one result reused across the sizes: the same numbers as the call
+    forward_dynamics_derivatives(t).evaluate(q, qd, tau, reused);
+    CHECK(reused.dq == a.dq);
+    CHECK(reused.dqd == a.dqd);
+    CHECK(reused.Minv == a.Minv);
+    CHECK(reused.qdd == a.qdd);
+    CHECK(reused.id.M == a.id.M);
     // with wrenches: the duals of forward_dynamics(q, qd, tau, w)
     wrench<double> w1, w2;
     w1.body = n, w1.force = random_vec(rng, 3, 20), w1.point = random_vec(rng, 3, 0.3);

@@ -9,6 +9,7 @@
 
 #include <nhdyn/dynamics/reference_derivatives.hpp>
 #include <nhdyn/dynamics/rne_derivatives.hpp>
+#include <nhdyn/dynamics/tree_factor.hpp>
 #include <nhdyn/nhdyn.hpp>
 #include <nhdyn/scalar/multiprecision.hpp>
 #include <random>
@@ -169,6 +170,46 @@ TEST_CASE("rne derivatives (analytic): equal the reference, CRBA and rne on rand
   CHECK(rel(c.dq, rq) < 1e-13);
   CHECK(rel(c.dqd, rqd) < 1e-13);
   CHECK(rel(c.tau, rne(p5.chain)(q, qd, qdd)) < 1e-13);
+}
+
+TEST_CASE("tree_ltl: M = LᵀL with the tree's sparsity, solves equal a dense Cholesky's, not-PD refused") {
+  std::mt19937_64 rng(613);
+  std::vector<tree<double>> trees{as_tree(presets::puma560<double>())};
+  for (int n : {1, 2, 5, 16, 48}) trees.push_back(nhdyn_ref::random_tree(rng, n, 0.4, n % 2 == 0));
+  trees.push_back(nhdyn_ref::random_tree(rng, 12, 0.0, false));  // a chain
+  for (const auto& t : trees) {
+    const int n = t.dof();
+    INFO("n = " << n);
+    const VectorXd q = random_vec(rng, n, 2);
+    const MatrixXd M = mass_matrix(t)(q);  // CRBA
+    std::vector<int> parent;
+    for (int i = 0; i < n; ++i) parent.push_back(t.parent(i));
+    const tree_sparsity s(parent);
+    const tree_ltl<double> f(M, s);
+    REQUIRE(f.ok());
+    // L as a dense matrix, only its (i, i) and (i, ancestor of i) entries: LᵀL must be all of M
+    // (M's other entries are zero: the sparsity is the tree's)
+    MatrixXd L = MatrixXd::Zero(n, n);
+    int pairs = 0;
+    for (int i = 0; i < n; ++i) {
+      L(i, i) = f.L(i, i);
+      for (int j = t.parent(i); j >= 0; j = t.parent(j), ++pairs) L(i, j) = f.L(i, j);
+    }
+    CHECK(pairs == s.pairs());
+    CHECK(rel(L.transpose() * L, M) < 1e-14);
+    // solves: against Eigen's dense Cholesky
+    const MatrixXd B = MatrixXd::NullaryExpr(n, 7, [&] { return nhdyn_ref::uniform(rng, -3, 3); });
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> X = B;
+    f.solve_in_place(X);
+    CHECK(rel(X, M.llt().solve(B)) < 1e-12);
+    // not positive definite (a leaf's diagonal, then the root's): refused
+    MatrixXd bad = M;
+    bad(n - 1, n - 1) = -1;
+    CHECK_FALSE(tree_ltl<double>(bad, s).ok());
+    bad = M;
+    bad(0, 0) = std::numeric_limits<double>::quiet_NaN();
+    CHECK_FALSE(tree_ltl<double>(bad, s).ok());
+  }
 }
 
 TEST_CASE("rne derivatives (analytic): with external wrenches, equal the duals of rne(q, qd, qdd, w)") {

@@ -27,7 +27,6 @@
 /// All take external wrenches as a last argument (`external_wrenches(t, {…})`). The dual-number
 /// linearizers of analysis/linearize.hpp compute the same matrices another way (the tests'
 /// reference).
-#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <vector>
 
@@ -36,30 +35,51 @@
 #include "../constraints/stages.hpp"
 #include "../dynamics/forward_dynamics.hpp"
 #include "../dynamics/rne_derivatives.hpp"
+#include "../dynamics/tree_factor.hpp"
 #include "../scalar/dual.hpp"
 #include "linearize.hpp"
 
 namespace nhdyn {
 
+namespace detail {
+/// A nonzero S_rc (or Ṡ_rc) of a constraint's S at one q.
+template <class T>
+struct s_nonzero {
+  int r, c;
+  T s;
+};
+}  // namespace detail
+
 /// τ and ∂τ/∂(q, η, η̇) of the nonholonomic inverse dynamics, and ∂q̇/∂q of the lift
 /// (q̇ = S(q)η; the kinematic rows of a state-space model).
 template <class T, int M>
 struct nh_derivatives_result {
+  using scalar_type = T;
   vecN<T, M> tau;
   Eigen::Matrix<T, M, Eigen::Dynamic> dq;  ///< ∂τ/∂q (m × n)
   Eigen::Matrix<T, M, M> deta, deta_dot;   ///< ∂τ/∂η, ∂τ/∂η̇ (m × m)
   Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> dqd_dq;  ///< ∂(Sη)/∂q (n × n)
+  /// rne's derivatives at the lifted state (q, Sη, Sη̇ + Ṡη): ∂v/∂q, ∂v/∂q̇, M and v.
+  rne_derivatives_result<T> id;
   /// [∂τ/∂q  ∂τ/∂η  ∂τ/∂η̇], as inverse_dynamics_linearizer gives it.
   Eigen::Matrix<T, M, Eigen::Dynamic> J() const {
     Eigen::Matrix<T, M, Eigen::Dynamic> j(tau.size(), dq.cols() + 2 * tau.size());
     j << dq, deta, deta_dot;
     return j;
   }
+  /// Scratch of the computation, kept so that evaluate reuses it: S's and Ṡ's nonzeros, the
+  /// constraint's [∂q̇/∂q_j; ∂q̈/∂q_j; ∂(Pv)/∂q_j] for j ∈ D, the n × (n + 2m + 1) matrix X = [∂v/∂q + …  ∂v/∂η  ∂v/∂η̇  v], Xᵀ, Xᵀ S and Sᵀ X.
+  struct scratch {
+    std::vector<detail::s_nonzero<T>> nz, nz_dot;
+    Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> jd, x, xt, stxt;
+    Eigen::Matrix<T, M, Eigen::Dynamic> stx;
+  } work;
 };
 
 
 /// ∂τ/∂(q, η, η̇) of the nonholonomic inverse dynamics of a tree and any constraint (see the
-/// file comment): `inverse_dynamics_derivatives(t, c)(q, eta, eta_dot [, w])`.
+/// file comment): `inverse_dynamics_derivatives(t, c)(q, eta, eta_dot [, w])`;
+/// `evaluate(q, eta, eta_dot, out)` reuses out's storage (double models, no wrenches).
 template <class S, class C>
 class inverse_dynamics_derivatives_fn {
  public:
@@ -79,21 +99,35 @@ class inverse_dynamics_derivatives_fn {
   template <class Q, class E, class ED>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                   const Eigen::MatrixBase<ED>& eta_dot) const {
-    return run(q, eta, eta_dot, [&](const auto& x, const auto& xd, const auto& xdd) { return d_(x, xd, xdd); });
+    nh_derivatives_result<result_scalar<Q, E, ED>, C::m_at_compile_time> out;
+    run(q, eta, eta_dot, out, [&](const auto& x, const auto& xd, const auto& xdd, auto& r) { r = d_(x, xd, xdd); });
+    return out;
   }
   template <class Q, class E, class ED, class Kin, class W>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
                   const external_wrenches_fn<Kin, W>& w) const {
-    return run(q, eta, eta_dot, [&](const auto& x, const auto& xd, const auto& xdd) { return d_(x, xd, xdd, w); });
+    nh_derivatives_result<promote_t<result_scalar<Q, E, ED>, W>, C::m_at_compile_time> out;
+    run(q, eta, eta_dot, out,
+        [&](const auto& x, const auto& xd, const auto& xdd, auto& r) { r = d_(x, xd, xdd, w); });
+    return out;
+  }
+  /// Into a result whose storage is reused: after the first call of a size, allocations only in
+  /// the constraint's dual pass. `out` must not alias the inputs.
+  template <class Q, class E, class ED>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
+                nh_derivatives_result<S, C::m_at_compile_time>& out) const {
+    run(q, eta, eta_dot, out,
+        [&](const auto& x, const auto& xd, const auto& xdd, auto& r) { d_.evaluate(x, xd, xdd, r); });
   }
 
  private:
-  template <class Q, class E, class ED, class D>
-  auto run(const Eigen::MatrixBase<Q>& q_in, const Eigen::MatrixBase<E>& eta_in, const Eigen::MatrixBase<ED>& eta_dot_in,
-           const D& derivatives) const {
+  template <class Q, class E, class ED>
+  using result_scalar = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename ED::Scalar>;
+
+  template <class Q, class E, class ED, class T, int M, class D>
+  void run(const Eigen::MatrixBase<Q>& q_in, const Eigen::MatrixBase<E>& eta_in, const Eigen::MatrixBase<ED>& eta_dot_in,
+           nh_derivatives_result<T, M>& out, const D& derivatives) const {
     constexpr int N = C::n_at_compile_time;
-    constexpr int M = C::m_at_compile_time;
-    using T = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename ED::Scalar>;
     detail::check_reduced_state(c_, q_in, eta_in, eta_dot_in);
     const int n = c_.dof(), m = c_.m();
     const vecN<T, N> q = q_in.template cast<T>();
@@ -102,11 +136,11 @@ class inverse_dynamics_derivatives_fn {
     const vecN<T, N> qd = apply_S(c_, q, eta);
     vecN<T, N> qdd = apply_S(c_, q, eta_dot);
     qdd += apply_Sdot(c_, q, qd, eta);
-    auto r = derivatives(q, qd, qdd);
-    using MatX = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>;
+    derivatives(q, qd, qdd, out.id);
+    const auto& r = out.id;
     // The constraint's pieces, by duals along q_j for the joints it depends on (j ∈ D): rows
     // [∂q̇/∂q_j; ∂q̈/∂q_j; ∂(P v)/∂q_j] with v held.
-    const vecN<T, N> v = r.tau;
+    const vecN<T, N>& v = r.tau;
     const auto along_q = [&](const auto& x) {
       using Dl = typename std::decay_t<decltype(x)>::Scalar;
       const vecN<Dl, M> e = eta.template cast<Dl>(), ed = eta_dot.template cast<Dl>();
@@ -118,11 +152,21 @@ class inverse_dynamics_derivatives_fn {
       y << xd, xdd, pv;
       return y;
     };
-    MatX Jq;
-    if (!cols_.empty())
-      Jq = detail::jacobian_columns<4>(along_q, q, cols_.data(), static_cast<int>(cols_.size()));
-    else
-      Jq.setZero(2 * n + m, n);
+    // Jd: column k is the derivative along q_{D_k} (one dual pass per 4 joints of D)
+    const int nd = static_cast<int>(cols_.size());
+    auto& Jd = out.work.jd;
+    Jd.resize(2 * n + m, nd);
+    {
+      using D4 = dual<T, 4>;
+      vecN<D4, N> xd(n);
+      for (int c0 = 0; c0 < nd; c0 += 4) {
+        for (int i = 0; i < n; ++i) xd(i) = D4(q(i));
+        for (int k = 0; k < 4 && c0 + k < nd; ++k) xd(cols_[static_cast<std::size_t>(c0 + k)]).derivative(k) = T(1);
+        const auto y = along_q(xd);
+        for (Eigen::Index rr = 0; rr < y.size(); ++rr)
+          for (int k = 0; k < 4 && c0 + k < nd; ++k) Jd(rr, c0 + k) = y(rr).derivative(k);
+      }
+    }
     // S and Ṡ at once: S depends on q_D alone, so Ṡ(q, q̇) = Σ_{j∈D} ∂S/∂q_j q̇_j is the
     // derivative of S(q + ε q̇_D) (one dual lane; the time derivative the concept defines).
     using D1 = dual<T, 1>;
@@ -131,52 +175,63 @@ class inverse_dynamics_derivatives_fn {
     const auto S_eps = c_.S(q_eps);
     // S's nonzeros (r, c, S_rc): the products with S and Sᵀ below cost one row or column per
     // nonzero (a base's few rows and the arm's identity), any constraint
-    struct nonzero {
-      int r, c;
-      T s;
-    };
-    std::vector<nonzero> nz, nz_dot;  // of S and of Ṡ
-    nz.reserve(static_cast<std::size_t>(n + 2 * m));
+    auto& nz = out.work.nz;
+    auto& nz_dot = out.work.nz_dot;
+    nz.clear(), nz_dot.clear();
     for (int cc = 0; cc < m; ++cc)
       for (int rr = 0; rr < n; ++rr) {
         const D1& e = S_eps(rr, cc);
         if (!is_exact_zero(e.value())) nz.push_back({rr, cc, T(e.value())});
         if (!is_exact_zero(e.derivative(0))) nz_dot.push_back({rr, cc, T(e.derivative(0))});
       }
-    const auto St_times = [&](const MatX& X) {  // Sᵀ X
-      Eigen::Matrix<T, M, Eigen::Dynamic> out = Eigen::Matrix<T, M, Eigen::Dynamic>::Zero(m, X.cols());
-      for (Eigen::Index k = 0; k < X.cols(); ++k)  // column by column: both matrices are column-major
-        for (const auto& e : nz) out(e.c, k) += e.s * X(e.r, k);
-      return out;
-    };
-    // ∂τ/∂q: P (V_q + V_q̇ ∂q̇/∂q + M ∂q̈/∂q) + ∂(P v)/∂q, the middle terms in columns D only
-    MatX& Xq = r.dq;
-    for (const int j : cols_)
-      for (int rr = 0; rr < n; ++rr) {
-        const T a1 = Jq(rr, j), a2 = Jq(n + rr, j);
+    // X = [X_q  X_η  X_η̇  v] (n × (n + 2m + 1)), then τ's derivatives = (SᵀE)⁻¹ Sᵀ X (one solve):
+    //   X_q = V_q + V_q̇ ∂q̇/∂q + M ∂q̈/∂q (the middle terms in columns D only),
+    //   X_η = V_q̇ S + M ∂q̈/∂η, ∂q̈/∂η = ∂(Ṡ(q, Sη)η)/∂η = Ṡ(q, q̇) + Σ_{j∈D} ∂(Sη)/∂q_j S_j,:
+    //         (Ṡ = Σ_j ∂S/∂q_j q̇_j is linear in q̇ and S depends on q_D alone),
+    //   X_η̇ = M S.
+    auto& X = out.work.x;
+    X.resize(n, n + 2 * m + 1);
+    X.leftCols(n) = r.dq;
+    X.rightCols(2 * m + 1).setZero();
+    auto Xq = X.leftCols(n);
+    auto Xe = X.middleCols(n, m);
+    auto Xed = X.middleCols(n + m, m);
+    for (int k = 0; k < nd; ++k)
+      for (int rr = 0, j = cols_[static_cast<std::size_t>(k)]; rr < n; ++rr) {
+        const T a1 = Jd(rr, k), a2 = Jd(n + rr, k);
         if (!is_exact_zero(a1)) Xq.col(j) += a1 * r.dqd.col(rr);
         if (!is_exact_zero(a2)) Xq.col(j) += a2 * r.M.col(rr);
       }
-    // ∂τ/∂η: P (V_q̇ S + M ∂q̈/∂η), ∂q̈/∂η = ∂(Ṡ(q, Sη)η)/∂η = Ṡ(q, q̇) + Σ_{j∈D} ∂(Sη)/∂q_j S_j,:
-    // (Ṡ = Σ_j ∂S/∂q_j q̇_j is linear in q̇ and S depends on q_D alone)
-    MatX Xe = MatX::Zero(n, m);
-    for (const auto& e : nz) Xe.col(e.c) += e.s * r.dqd.col(e.r);
+    for (const auto& e : nz) {
+      Xe.col(e.c) += e.s * r.dqd.col(e.r);
+      Xed.col(e.c) += e.s * r.M.col(e.r);
+    }
     for (const auto& e : nz_dot) Xe.col(e.c) += e.s * r.M.col(e.r);
-    for (const int j : cols_)
+    for (int k = 0; k < nd; ++k)
       for (const auto& e : nz)
-        if (e.r == j)
+        if (e.r == cols_[static_cast<std::size_t>(k)])
           for (int rr = 0; rr < n; ++rr)
-            if (!is_exact_zero(Jq(rr, j))) Xe.col(e.c) += (Jq(rr, j) * e.s) * r.M.col(rr);
-    nh_derivatives_result<T, M> out;
-    out.tau = detail::solve_StE(c_, q, apply_St(c_, q, v));
-    out.dq = detail::solve_StE(c_, q, St_times(Xq));
-    out.dq += Jq.bottomRows(m);
-    out.deta = detail::solve_StE(c_, q, Eigen::Matrix<T, M, M>(St_times(Xe)));
-    MatX MS = MatX::Zero(n, m);  // M S
-    for (const auto& e : nz) MS.col(e.c) += e.s * r.M.col(e.r);
-    out.deta_dot = detail::solve_StE(c_, q, Eigen::Matrix<T, M, M>(St_times(MS)));
-    out.dqd_dq = Jq.topRows(n);
-    return out;
+            if (!is_exact_zero(Jd(rr, k))) Xe.col(e.c) += (Jd(rr, k) * e.s) * r.M.col(rr);
+    X.col(n + 2 * m) = v;
+    // Sᵀ X = (Xᵀ S)ᵀ: on Xᵀ each nonzero of S is one vectorised column operation
+    auto& Xt = out.work.xt;
+    Xt = X.transpose();
+    auto& StXt = out.work.stxt;
+    StXt.setZero(X.cols(), m);
+    for (const auto& e : nz) StXt.col(e.c) += e.s * Xt.col(e.r);
+    auto& StX = out.work.stx;
+    StX = StXt.transpose();
+    StX = detail::solve_StE(c_, q, std::move(StX));
+    out.tau = StX.col(n + 2 * m);
+    out.dq = StX.leftCols(n);
+    out.deta = StX.middleCols(n, m);
+    out.deta_dot = StX.middleCols(n + m, m);
+    out.dqd_dq.setZero(n, n);
+    for (int k = 0; k < nd; ++k) {
+      const int j = cols_[static_cast<std::size_t>(k)];
+      out.dq.col(j) += Jd.col(k).tail(m);
+      out.dqd_dq.col(j) = Jd.col(k).head(n);
+    }
   }
 
   rne_derivatives_fn<S> d_;
@@ -195,6 +250,8 @@ template <class T>
 struct fd_derivatives_result {
   Eigen::Matrix<T, Eigen::Dynamic, 1> qdd;
   Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> dq, dqd, Minv;  ///< ∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ = M⁻¹
+  /// The inverse dynamics' derivatives at (q, q̇, q̈): ∂τ/∂q, ∂τ/∂q̇ and M (and τ).
+  rne_derivatives_result<T> id;
   /// A, B of ẋ = (q̇, q̈), x = (q, q̇), u = τ.
   state_space<T, Eigen::Dynamic, Eigen::Dynamic> state_space_model() const {
     const Eigen::Index n = qdd.size();
@@ -207,17 +264,27 @@ struct fd_derivatives_result {
     s.B.bottomRows(n) = Minv;
     return s;
   }
+  /// Scratch of the computation, kept so that evaluate reuses it: M's factorisation and the
+  /// right-hand sides [∂τ/∂q  ∂τ/∂q̇  I] row-major.
+  tree_ltl<T> factor;
+  Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rhs;
 };
 
 /// ∂q̈/∂(q, q̇, τ) of a tree's forward dynamics: `forward_dynamics_derivatives(t)(q, qd, tau [, w])`.
-/// q̈ by forward_dynamics(t) (its checks and its choice of algorithm); M⁻¹ by a Cholesky
-/// factorisation of the M that rne_derivatives returns (refused, naming the model, when M is
-/// not positive definite).
+/// q̈ by forward_dynamics(t) (its checks and its choice of algorithm); M⁻¹ and the products
+/// with it by the tree-sparse factorisation M = LᵀL (dynamics/tree_factor.hpp) of the M that
+/// rne_derivatives returns (refused, naming the model, when M is not positive definite).
+/// `evaluate(q, qd, tau, out)` reuses out's storage (double models, no wrenches): no
+/// allocation but q̈'s after the first call of a size.
 template <class S>
 class fd_derivatives_fn {
  public:
   explicit fd_derivatives_fn(const tree<S>& t, rne_options o = {}, fd_options f = {})
-      : fd_(t, o, f), d_(t, o), name_(t.name()) {}
+      : fd_(t, o, f), d_(t, o), name_(t.name()) {
+    std::vector<int> parent;
+    for (int i = 0; i < t.dof(); ++i) parent.push_back(t.parent(i));
+    sparsity_ = tree_sparsity(parent);
+  }
   int dof() const { return d_.dof(); }
 
   template <class Q, class QD, class TAU>
@@ -232,31 +299,54 @@ class fd_derivatives_fn {
     const auto qdd = fd_(q, qd, tau, w);
     return finish(qdd, d_(q, qd, qdd, w));
   }
+  /// Into a result whose storage is reused (see the class comment). `out` must not alias the
+  /// inputs.
+  template <class Q, class QD, class TAU>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
+                fd_derivatives_result<S>& out) const {
+    out.qdd = fd_(q, qd, tau);
+    d_.evaluate(q, qd, out.qdd, out.id);
+    solve(out);
+  }
 
  private:
   template <class QDD, class T>
-  fd_derivatives_result<T> finish(const QDD& qdd, const rne_derivatives_result<T>& r) const {
+  fd_derivatives_result<T> finish(const QDD& qdd, rne_derivatives_result<T>&& r) const {
     fd_derivatives_result<T> out;
     out.qdd = qdd.template cast<T>();
+    out.id = std::move(r);
+    solve(out);
+    return out;
+  }
+  template <class T>
+  void solve(fd_derivatives_result<T>& out) const {
     const int n = dof();
+    const auto& r = out.id;
+    using MatX = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>;
     if constexpr (std::is_floating_point_v<T>) {
-      const Eigen::LLT<Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>> llt(r.M);
-      if (llt.info() != Eigen::Success)
+      // M⁻¹ [∂τ/∂q  ∂τ/∂q̇  I] by M's sparse LᵀL factorisation (dynamics/tree_factor.hpp):
+      // one row operation over the 3n right-hand sides per (body, ancestor) pair
+      if (!out.factor.factor(r.M, sparsity_))
         throw numerical_error("forward_dynamics_derivatives: model '" + name_ +
                               "': the mass matrix is not positive definite at this q");
-      out.Minv = llt.solve(Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>::Identity(n, n));
+      auto& x = out.rhs;
+      x.resize(n, 3 * n);
+      x << r.dq, r.dqd, MatX::Identity(n, n);
+      out.factor.solve_in_place(x);
+      out.dq = -x.leftCols(n);
+      out.dqd = -x.middleCols(n, n);
+      out.Minv = x.rightCols(n);
     } else {
-      out.Minv = ldlt_factor<T, dynamic>(r.M, "the mass matrix").solve(
-          Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>::Identity(n, n));
+      out.Minv = ldlt_factor<T, dynamic>(r.M, "the mass matrix").solve(MatX::Identity(n, n));
+      out.dq.noalias() = -out.Minv * r.dq;
+      out.dqd.noalias() = -out.Minv * r.dqd;
     }
-    out.dq.noalias() = -out.Minv * r.dq;
-    out.dqd.noalias() = -out.Minv * r.dqd;
-    return out;
   }
 
   forward_dynamics_fn<S, dynamic, tree<S>> fd_;
   rne_derivatives_fn<S> d_;
   std::string name_;
+  tree_sparsity sparsity_;  // the ancestor lists, for M's sparse factorisation
 };
 
 template <class S>
@@ -269,10 +359,13 @@ template <class T, int M>
 struct nh_fd_derivatives_result {
   vecN<T, M> eta_dot;
   state_space<T, Eigen::Dynamic, M> ss;  ///< A ((n+m) × (n+m)), B ((n+m) × m)
+  /// The inverse dynamics' derivatives at (q, η, η̇): ∂τ/∂(q, η, η̇) (K = ∂τ/∂η̇ among them).
+  nh_derivatives_result<T, M> id;
 };
 
 /// A, B of a constrained tree's forward dynamics, analytically:
-/// `forward_dynamics_derivatives(t, c)(q, eta, tau [, w])`.
+/// `forward_dynamics_derivatives(t, c)(q, eta, tau [, w])`; `evaluate(q, eta, tau, out)`
+/// reuses out's storage (double models, no wrenches).
 template <class S, class C>
 class nh_fd_derivatives_fn {
  public:
@@ -283,20 +376,36 @@ class nh_fd_derivatives_fn {
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                   const Eigen::MatrixBase<TAU>& tau) const {
     const auto ed = fd_(q, eta, tau);
-    return finish(q, ed, id_(q, eta, ed));
+    auto J = id_(q, eta, ed);
+    nh_fd_derivatives_result<typename decltype(J)::scalar_type, C::m_at_compile_time> out;
+    out.id = std::move(J);
+    finish(q, ed, out);
+    return out;
   }
   template <class Q, class E, class TAU, class Kin, class W>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                   const external_wrenches_fn<Kin, W>& w) const {
     const auto ed = fd_(q, eta, tau, w);
-    return finish(q, ed, id_(q, eta, ed, w));
+    auto J = id_(q, eta, ed, w);
+    nh_fd_derivatives_result<typename decltype(J)::scalar_type, C::m_at_compile_time> out;
+    out.id = std::move(J);
+    finish(q, ed, out);
+    return out;
+  }
+  /// Into a result whose storage is reused. `out` must not alias the inputs.
+  template <class Q, class E, class TAU>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
+                nh_fd_derivatives_result<S, C::m_at_compile_time>& out) const {
+    const auto ed = fd_(q, eta, tau);
+    id_.evaluate(q, eta, ed, out.id);
+    finish(q, ed, out);
   }
 
  private:
   template <class Q, class ED, class T, int M>
-  nh_fd_derivatives_result<T, M> finish(const Q& q, const ED& ed, const nh_derivatives_result<T, M>& J) const {
+  void finish(const Q& q, const ED& ed, nh_fd_derivatives_result<T, M>& out) const {
     const int n = id_.dof(), m = id_.m();
-    nh_fd_derivatives_result<T, M> out;
+    const auto& J = out.id;
     out.eta_dot = ed.template cast<T>();
     const Eigen::PartialPivLU<Eigen::Matrix<T, M, M>> K(J.deta_dot);
     out.ss.A.setZero(n + m, n + m);
@@ -306,7 +415,6 @@ class nh_fd_derivatives_fn {
     out.ss.A.block(n, 0, m, n) = -K.solve(J.dq);
     out.ss.A.block(n, n, m, m) = -K.solve(J.deta);
     out.ss.B.bottomRows(m) = K.inverse();
-    return out;
   }
 
   decltype(nh_forward_dynamics(std::declval<const tree<S>&>(), std::declval<const C&>())) fd_;

@@ -108,10 +108,20 @@ struct bicycle {
     a(1, heading) = T(wheelbase) * d.c;
     return a;
   }
+  /// S(q), filled directly (one sin/cos of ψ and of δ; the layout of S_times).
   template <class Q>
   auto S(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<Sc, typename Q::Scalar>;
-    return detail::columns_of<T, N, m_at_compile_time>(n, n - 2, [&](const auto& e) { return S_times(q, e); });
+    const auto p = detail::sincos_of(T(q(heading)));
+    const auto d = steering(T(q(steer)));
+    matrix<T, N, m_at_compile_time> s = matrix<T, N, m_at_compile_time>::Zero(n, n - 2);
+    s(x, 0) = p.c;
+    s(y, 0) = p.s;
+    s(heading, 0) = d.s / (T(wheelbase) * d.c);
+    s(steer, 1) = T(1);
+    for (int j = 0, c = 2; j < n; ++j)
+      if (!is_base_or_steer(j)) s(j, c++) = T(1);
+    return s;
   }
   template <class Q, class QD>
   auto Sdot(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd) const {

@@ -126,10 +126,24 @@ struct rolling_wheels {
     a(2, right) = T(-radius * right_sign);
     return a;
   }
+  /// S(q), filled directly (one sin/cos of ψ; the layout of S_times).
   template <class Q>
   auto S(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<Sc, typename Q::Scalar>;
-    return detail::columns_of<T, N, m_at_compile_time>(n, n - 3, [&](const auto& e) { return S_times(q, e); });
+    const auto p = detail::sincos_of(T(q(heading)));
+    const wheel_map k = map();
+    matrix<T, N, m_at_compile_time> s = matrix<T, N, m_at_compile_time>::Zero(n, n - 3);
+    s(x, 0) = p.c * T(k.uL) - p.s * T(k.lL);
+    s(y, 0) = p.s * T(k.uL) + p.c * T(k.lL);
+    s(heading, 0) = T(k.wL);
+    s(left, 0) = T(1);
+    s(x, 1) = p.c * T(k.uR) - p.s * T(k.lR);
+    s(y, 1) = p.s * T(k.uR) + p.c * T(k.lR);
+    s(heading, 1) = T(k.wR);
+    s(right, 1) = T(1);
+    for (int j = 0, c = 2; j < n; ++j)
+      if (!is_base_or_wheel(j)) s(j, c++) = T(1);
+    return s;
   }
   template <class Q, class QD>
   auto Sdot(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd) const {

@@ -232,6 +232,8 @@ void check_result(const R& out, const Q& q, const QD& qd, const QDD& qdd, const 
 /// Throws numerical_error if a result computed from finite inputs is not finite.
 template <class R>
 void check_overflow(const R& out, const char* algorithm) {
+  if (finite_range(out, 0, out.size())) [[likely]]
+    return;
   for (Eigen::Index i = 0; i < out.size(); ++i)
     if (!is_finite_scalar(out(i)))
       throw numerical_error(std::string(algorithm) + ": result " + std::to_string(i) +

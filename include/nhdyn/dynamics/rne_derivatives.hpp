@@ -316,8 +316,8 @@ class rne_derivatives_fn {
   template <class T>
   static void check_result(const rne_derivatives_result<T>& out) {
     detail::check_overflow(out.tau, "rne_derivatives");
-    for (const auto* m : {&out.dq, &out.dqd, &out.M})
-      for (Eigen::Index c = 0; c < m->cols(); ++c) detail::check_overflow(m->col(c), "rne_derivatives (a derivative)");
+    for (const auto* m : {&out.dq, &out.dqd, &out.M})  // entries in column-major order
+      detail::check_overflow(*m, "rne_derivatives (a derivative)");
   }
   template <class Q, class QD, class QDD>
   void check(const Q& q, const QD& qd, const QDD& qdd) const {

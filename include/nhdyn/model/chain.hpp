@@ -218,24 +218,20 @@ inline void check_size(const V& v, int n, const char* what) {
   throw input_error(os.str());
 }
 /// Whether v's entries begin…end−1 are all finite (false for NaN and ±Inf). For float and
-/// double one pass without a branch per entry: x·0 is 0 for a finite x and NaN otherwise, so
-/// their sum is 0 exactly when every entry is finite (one fused multiply-add each; under
-/// -ffast-math, which would fold x·0 to 0, the exponent bits instead).
+/// double one pass without a branch per entry: an entry is not finite when its exponent bits
+/// are all set, tested on the bits as an integer reduction that vectorises (no floating-point
+/// arithmetic, so it is also right under -ffast-math).
 template <class V>
 inline bool finite_range(const V& v, Eigen::Index begin, Eigen::Index end) {
   using T = typename V::Scalar;
   if constexpr (std::is_same_v<T, double> || std::is_same_v<T, float>) {
-#ifndef __FAST_MATH__
-    T z(0);
-    for (Eigen::Index i = begin; i < end; ++i) z += T(v(i)) * T(0);
-    return z == T(0);
-#else
     using U = std::conditional_t<std::is_same_v<T, double>, std::uint64_t, std::uint32_t>;
     constexpr U exp_mask = std::is_same_v<T, double> ? U(0x7ff0000000000000ULL) : U(0x7f800000U);
-    bool bad = false;
-    for (Eigen::Index i = begin; i < end; ++i) bad |= (std::bit_cast<U>(T(v(i))) & exp_mask) == exp_mask;
-    return !bad;
-#endif
+    // (bits & mask) ^ mask is 0 exactly for a non-finite entry: its minimum over the range
+    // (a vectorised integer reduction) is 0 when one is
+    U low = ~U(0);
+    for (Eigen::Index i = begin; i < end; ++i) low = std::min(low, U((std::bit_cast<U>(T(v(i))) & exp_mask) ^ exp_mask));
+    return low != 0;
   } else {
     for (Eigen::Index i = begin; i < end; ++i)
       if (!is_finite_scalar(v(i))) return false;
