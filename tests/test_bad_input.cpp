@@ -192,6 +192,31 @@ TEST_CASE("bad input: a non-finite entry the result does not depend on is report
   }
 }
 
+TEST_CASE("finite_range: every kind of non-finite double and float is seen, no finite one, at any position") {
+  using L = std::numeric_limits<double>;
+  const std::vector<double> finite{0.0, -0.0, 1.0, -2.5, L::max(), L::lowest(), L::min(), L::denorm_min(), -L::denorm_min()};
+  const std::vector<double> not_finite{L::infinity(), -L::infinity(), L::quiet_NaN(), -L::quiet_NaN(), L::signaling_NaN()};
+  for (int pos : {0, 5, 16}) {  // first, middle, last of 17 (past a vector register's width)
+    for (double x : finite) {
+      VectorXd v = VectorXd::Constant(17, 3.0);
+      v(pos) = x;
+      CHECK(detail::finite_range(v, 0, 17));
+      Eigen::VectorXf f = v.cast<float>();
+      CHECK(detail::finite_range(f, 0, 17) == std::isfinite(float(x)));  // L::max() is +Inf as a float
+    }
+    for (double x : not_finite) {
+      VectorXd v = VectorXd::Constant(17, 3.0);
+      v(pos) = x;
+      INFO("position " << pos << ", " << x);
+      CHECK_FALSE(detail::finite_range(v, 0, 17));
+      CHECK(detail::finite_range(v, 0, pos));  // the range before it is finite
+      Eigen::VectorXf f = v.cast<float>();
+      CHECK_FALSE(detail::finite_range(f, 0, 17));
+    }
+  }
+  CHECK(detail::finite_range(VectorXd(0), 0, 0));
+}
+
 TEST_CASE("bad input: finite inputs whose result overflows are a numerical_error, not Inf") {
   const auto ch = two_links();
   const VectorXd z = VectorXd::Zero(2);

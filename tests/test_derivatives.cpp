@@ -44,9 +44,19 @@ void check_nh(const tree<double>& t, const C& c, std::mt19937_64& rng, const std
   CHECK(rel(a.ss.A, b.A) < 1e-10);
   CHECK(rel(a.ss.B, b.B) < 1e-10);
   CHECK(rel(a.eta_dot, nh_forward_dynamics(t, c)(q, eta, tau)) < 1e-13);
-  // evaluate into a result that held another state: the same numbers as the call
+  // evaluate into a result that held another size (every matrix and the scratch), then
+  // another state: the same numbers as the call
   nh_derivatives_result<double, C::m_at_compile_time> e;
   nh_fd_derivatives_result<double, C::m_at_compile_time> ef;
+  if constexpr (C::m_at_compile_time == Eigen::Dynamic) {
+    for (auto* r : {&e, &ef.id}) {
+      r->tau.setOnes(m + 2), r->dq.setOnes(m + 2, n + 3), r->deta.setOnes(1, 1), r->deta_dot.setOnes(m + 1, m + 1);
+      r->dqd_dq.setOnes(2, 5), r->id.M.setOnes(n + 4, n + 4), r->id.dq.setOnes(1, 1);
+      r->work.x.setOnes(3, 3), r->work.xt.setOnes(n + 9, 2), r->work.stx.setOnes(m + 3, 1), r->work.jd.setOnes(7, 7);
+      r->work.nz.resize(3);
+    }
+    ef.ss.A.setOnes(3, 3), ef.ss.B.setOnes(4, 2), ef.eta_dot.setOnes(m + 5);
+  }
   inverse_dynamics_derivatives(t, c).evaluate(VectorXd(2 * q), eta_dot, tau, e);
   forward_dynamics_derivatives(t, c).evaluate(VectorXd(2 * q), eta_dot, tau, ef);
   inverse_dynamics_derivatives(t, c).evaluate(q, eta, eta_dot, e);

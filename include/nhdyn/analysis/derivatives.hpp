@@ -67,8 +67,10 @@ struct nh_derivatives_result {
     j << dq, deta, deta_dot;
     return j;
   }
-  /// Scratch of the computation, kept so that evaluate reuses it: S's and Ṡ's nonzeros, the
-  /// constraint's [∂q̇/∂q_j; ∂q̈/∂q_j; ∂(Pv)/∂q_j] for j ∈ D, the n × (n + 2m + 1) matrix X = [∂v/∂q + …  ∂v/∂η  ∂v/∂η̇  v], Xᵀ, Xᵀ S and Sᵀ X.
+  /// Scratch of the computation, kept by evaluate for its next call (empty in a result that
+  /// operator() returns): S's and Ṡ's nonzeros, the constraint's [∂q̇/∂q_j; ∂q̈/∂q_j;
+  /// ∂(Pv)/∂q_j] for j ∈ D, X = [∂v/∂q + …  ∂v/∂η  ∂v/∂η̇  v] (n × (n + 2m + 1)), Xᵀ, XᵀS
+  /// and SᵀX.
   struct scratch {
     std::vector<detail::s_nonzero<T>> nz, nz_dot;
     Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> jd, x, xt, stxt;
@@ -79,7 +81,8 @@ struct nh_derivatives_result {
 
 /// ∂τ/∂(q, η, η̇) of the nonholonomic inverse dynamics of a tree and any constraint (see the
 /// file comment): `inverse_dynamics_derivatives(t, c)(q, eta, eta_dot [, w])`;
-/// `evaluate(q, eta, eta_dot, out)` reuses out's storage (double models, no wrenches).
+/// `evaluate(q, eta, eta_dot, out)` reuses out's matrices and scratch (inputs in the model's
+/// scalar, no wrenches).
 template <class S, class C>
 class inverse_dynamics_derivatives_fn {
  public:
@@ -101,6 +104,7 @@ class inverse_dynamics_derivatives_fn {
                   const Eigen::MatrixBase<ED>& eta_dot) const {
     nh_derivatives_result<result_scalar<Q, E, ED>, C::m_at_compile_time> out;
     run(q, eta, eta_dot, out, [&](const auto& x, const auto& xd, const auto& xdd, auto& r) { r = d_(x, xd, xdd); });
+    out.work = {};
     return out;
   }
   template <class Q, class E, class ED, class Kin, class W>
@@ -109,11 +113,16 @@ class inverse_dynamics_derivatives_fn {
     nh_derivatives_result<promote_t<result_scalar<Q, E, ED>, W>, C::m_at_compile_time> out;
     run(q, eta, eta_dot, out,
         [&](const auto& x, const auto& xd, const auto& xdd, auto& r) { r = d_(x, xd, xdd, w); });
+    out.work = {};
     return out;
   }
-  /// Into a result whose storage is reused: after the first call of a size, allocations only in
-  /// the constraint's dual pass. `out` must not alias the inputs.
+  /// Into a result whose storage (matrices and scratch) is reused from call to call, for
+  /// inputs in the model's scalar; the small vectors of the lift and the constraint's dual
+  /// pass are still allocated. `out` must not alias the inputs; after an exception its
+  /// contents are unspecified.
   template <class Q, class E, class ED>
+    requires(std::is_same_v<typename Q::Scalar, S> && std::is_same_v<typename E::Scalar, S> &&
+             std::is_same_v<typename ED::Scalar, S>)
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
                 nh_derivatives_result<S, C::m_at_compile_time>& out) const {
     run(q, eta, eta_dot, out,
@@ -156,7 +165,7 @@ class inverse_dynamics_derivatives_fn {
     const int nd = static_cast<int>(cols_.size());
     auto& Jd = out.work.jd;
     Jd.resize(2 * n + m, nd);
-    {
+    if (nd > 0) {
       using D4 = dual<T, 4>;
       vecN<D4, N> xd(n);
       for (int c0 = 0; c0 < nd; c0 += 4) {
@@ -264,8 +273,8 @@ struct fd_derivatives_result {
     s.B.bottomRows(n) = Minv;
     return s;
   }
-  /// Scratch of the computation, kept so that evaluate reuses it: M's factorisation and the
-  /// right-hand sides [∂τ/∂q  ∂τ/∂q̇  I] row-major.
+  /// Scratch of the computation, kept by evaluate for its next call (empty in a result that
+  /// operator() returns): M's factorisation and the right-hand sides [∂τ/∂q  ∂τ/∂q̇  I].
   tree_ltl<T> factor;
   Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rhs;
 };
@@ -274,8 +283,8 @@ struct fd_derivatives_result {
 /// q̈ by forward_dynamics(t) (its checks and its choice of algorithm); M⁻¹ and the products
 /// with it by the tree-sparse factorisation M = LᵀL (dynamics/tree_factor.hpp) of the M that
 /// rne_derivatives returns (refused, naming the model, when M is not positive definite).
-/// `evaluate(q, qd, tau, out)` reuses out's storage (double models, no wrenches): no
-/// allocation but q̈'s after the first call of a size.
+/// `evaluate(q, qd, tau, out)` reuses out's matrices and scratch from call to call (inputs in
+/// the model's scalar, no wrenches); q̈ comes from forward_dynamics as a new vector.
 template <class S>
 class fd_derivatives_fn {
  public:
@@ -300,8 +309,10 @@ class fd_derivatives_fn {
     return finish(qdd, d_(q, qd, qdd, w));
   }
   /// Into a result whose storage is reused (see the class comment). `out` must not alias the
-  /// inputs.
+  /// inputs; after an exception its contents are unspecified.
   template <class Q, class QD, class TAU>
+    requires(std::is_same_v<typename Q::Scalar, S> && std::is_same_v<typename QD::Scalar, S> &&
+             std::is_same_v<typename TAU::Scalar, S>)
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                 fd_derivatives_result<S>& out) const {
     out.qdd = fd_(q, qd, tau);
@@ -316,6 +327,8 @@ class fd_derivatives_fn {
     out.qdd = qdd.template cast<T>();
     out.id = std::move(r);
     solve(out);
+    out.factor = {};  // evaluate's scratch: not carried by a returned result
+    out.rhs.resize(0, 0);
     return out;
   }
   template <class T>
@@ -365,7 +378,8 @@ struct nh_fd_derivatives_result {
 
 /// A, B of a constrained tree's forward dynamics, analytically:
 /// `forward_dynamics_derivatives(t, c)(q, eta, tau [, w])`; `evaluate(q, eta, tau, out)`
-/// reuses out's storage (double models, no wrenches).
+/// reuses out's inverse-dynamics matrices and scratch (inputs in the model's scalar, no
+/// wrenches).
 template <class S, class C>
 class nh_fd_derivatives_fn {
  public:
@@ -380,6 +394,7 @@ class nh_fd_derivatives_fn {
     nh_fd_derivatives_result<typename decltype(J)::scalar_type, C::m_at_compile_time> out;
     out.id = std::move(J);
     finish(q, ed, out);
+    out.id.work = {};
     return out;
   }
   template <class Q, class E, class TAU, class Kin, class W>
@@ -390,10 +405,14 @@ class nh_fd_derivatives_fn {
     nh_fd_derivatives_result<typename decltype(J)::scalar_type, C::m_at_compile_time> out;
     out.id = std::move(J);
     finish(q, ed, out);
+    out.id.work = {};
     return out;
   }
-  /// Into a result whose storage is reused. `out` must not alias the inputs.
+  /// Into a result whose storage is reused. `out` must not alias the inputs; after an
+  /// exception its contents are unspecified.
   template <class Q, class E, class TAU>
+    requires(std::is_same_v<typename Q::Scalar, S> && std::is_same_v<typename E::Scalar, S> &&
+             std::is_same_v<typename TAU::Scalar, S>)
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                 nh_fd_derivatives_result<S, C::m_at_compile_time>& out) const {
     const auto ed = fd_(q, eta, tau);

@@ -238,6 +238,8 @@ void check_overflow(const R& out, const char* algorithm) {
     if (!is_finite_scalar(out(i)))
       throw numerical_error(std::string(algorithm) + ": result " + std::to_string(i) +
                             " is not finite although every input is (overflow)");
+  // reached only where std::isfinite cannot see it (-ffinite-math-only): still refused
+  throw numerical_error(std::string(algorithm) + ": a result is not finite although every input is (overflow)");
 }
 
 }  // namespace detail

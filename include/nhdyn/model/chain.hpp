@@ -219,19 +219,20 @@ inline void check_size(const V& v, int n, const char* what) {
 }
 /// Whether v's entries begin…end−1 are all finite (false for NaN and ±Inf). For float and
 /// double one pass without a branch per entry: an entry is not finite when its exponent bits
-/// are all set, tested on the bits as an integer reduction that vectorises (no floating-point
-/// arithmetic, so it is also right under -ffast-math).
+/// are all set, tested on the bits as an integer reduction that vectorises even on baseline
+/// x86-64 (no floating-point arithmetic, so it is also right under -ffast-math).
 template <class V>
 inline bool finite_range(const V& v, Eigen::Index begin, Eigen::Index end) {
   using T = typename V::Scalar;
   if constexpr (std::is_same_v<T, double> || std::is_same_v<T, float>) {
     using U = std::conditional_t<std::is_same_v<T, double>, std::uint64_t, std::uint32_t>;
     constexpr U exp_mask = std::is_same_v<T, double> ? U(0x7ff0000000000000ULL) : U(0x7f800000U);
-    // (bits & mask) ^ mask is 0 exactly for a non-finite entry: its minimum over the range
-    // (a vectorised integer reduction) is 0 when one is
-    U low = ~U(0);
-    for (Eigen::Index i = begin; i < end; ++i) low = std::min(low, U((std::bit_cast<U>(T(v(i))) & exp_mask) ^ exp_mask));
-    return low != 0;
+    // (bits & mask) + the exponent's lowest bit carries into the sign bit exactly when every
+    // exponent bit is set (NaN, ±Inf): OR over the range, then test that bit
+    constexpr U exp_one = exp_mask & ~(exp_mask << 1), top = ~(~U(0) >> 1);
+    U any = 0;
+    for (Eigen::Index i = begin; i < end; ++i) any |= U((std::bit_cast<U>(T(v(i))) & exp_mask) + exp_one);
+    return (any & top) == 0;
   } else {
     for (Eigen::Index i = begin; i < end; ++i)
       if (!is_finite_scalar(v(i))) return false;
@@ -259,6 +260,8 @@ inline void check_finite(const V& v, const char* what) {
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (!is_finite_scalar(v(i))) [[unlikely]]
       throw_not_finite(what, i, value_of(v(i)));
+  if constexpr (std::is_same_v<T, double> || std::is_same_v<T, float>)  // finite_range saw one that
+    throw input_error(std::string(what) + " has an entry that is not finite");  // std::isfinite cannot (-ffinite-math-only)
 }
 }  // namespace detail
 
