@@ -32,8 +32,8 @@
 namespace nhdyn {
 
 namespace detail {
-/// Whether every entry is finite: detail::finite_range column by column (one pass the compiler
-/// vectorises; the exponent bits under -ffast-math).
+/// Whether every entry is finite: detail::finite_range column by column (a vectorised test of
+/// the exponent bits).
 template <class X>
 bool all_finite(const X& x) {
   for (Eigen::Index k = 0; k < x.cols(); ++k)

@@ -42,6 +42,11 @@
 namespace nhdyn {
 
 namespace detail {
+/// Every argument's scalar is S (the evaluate overloads: a reused result is in the model's
+/// scalar, and inputs of another are not silently converted to it).
+template <class S, class... X>
+concept in_scalar = (std::is_same_v<typename X::Scalar, S> && ...);
+
 /// A nonzero S_rc (or Ṡ_rc) of a constraint's S at one q.
 template <class T>
 struct s_nonzero {
@@ -121,8 +126,7 @@ class inverse_dynamics_derivatives_fn {
   /// pass are still allocated. `out` must not alias the inputs; after an exception its
   /// contents are unspecified.
   template <class Q, class E, class ED>
-    requires(std::is_same_v<typename Q::Scalar, S> && std::is_same_v<typename E::Scalar, S> &&
-             std::is_same_v<typename ED::Scalar, S>)
+    requires detail::in_scalar<S, Q, E, ED>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
                 nh_derivatives_result<S, C::m_at_compile_time>& out) const {
     run(q, eta, eta_dot, out,
@@ -311,8 +315,7 @@ class fd_derivatives_fn {
   /// Into a result whose storage is reused (see the class comment). `out` must not alias the
   /// inputs; after an exception its contents are unspecified.
   template <class Q, class QD, class TAU>
-    requires(std::is_same_v<typename Q::Scalar, S> && std::is_same_v<typename QD::Scalar, S> &&
-             std::is_same_v<typename TAU::Scalar, S>)
+    requires detail::in_scalar<S, Q, QD, TAU>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                 fd_derivatives_result<S>& out) const {
     out.qdd = fd_(q, qd, tau);
@@ -411,8 +414,7 @@ class nh_fd_derivatives_fn {
   /// Into a result whose storage is reused. `out` must not alias the inputs; after an
   /// exception its contents are unspecified.
   template <class Q, class E, class TAU>
-    requires(std::is_same_v<typename Q::Scalar, S> && std::is_same_v<typename E::Scalar, S> &&
-             std::is_same_v<typename TAU::Scalar, S>)
+    requires detail::in_scalar<S, Q, E, TAU>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                 nh_fd_derivatives_result<S, C::m_at_compile_time>& out) const {
     const auto ed = fd_(q, eta, tau);
