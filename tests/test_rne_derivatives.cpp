@@ -7,6 +7,8 @@
 /// armature, massless bodies, point masses), paper5 as a tree and puma560.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include <nhdyn/dynamics/reference_derivatives.hpp>
 #include <nhdyn/dynamics/rne_derivatives.hpp>
 #include <nhdyn/dynamics/tree_factor.hpp>
@@ -195,11 +197,30 @@ TEST_CASE("tree_ltl: M = LᵀL with the tree's sparsity, solves equal a dense Ch
       for (int j = t.parent(i); j >= 0; j = t.parent(j)) L(i, j) = f.L(i, j);
     }
     CHECK(rel(L.transpose() * L, M) < 1e-14);
-    // solves: against Eigen's dense Cholesky
-    const MatrixXd B = MatrixXd::NullaryExpr(n, 7, [&] { return nhdyn_ref::uniform(rng, -3, 3); });
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> X = B;
-    f.solve_in_place(X);
-    CHECK(rel(X, M.llt().solve(B)) < 1e-12);
+    // the descendant lists are the ancestor lists inverted, increasing
+    for (int j = 0; j < n; ++j) {
+      std::vector<int> expect;
+      for (int i = 0; i < n; ++i)
+        if (std::find(s.begin(i), s.end(i), j) != s.end(i)) expect.push_back(i);
+      CHECK(std::vector<int>(s.desc_begin(j), s.desc_end(j)) == expect);
+    }
+    // solves: against Eigen's dense Cholesky, for column counts that use every block width
+    // of the solve (48, 8, 4 and single columns) and a view into a wider matrix
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> X;
+    for (int k : {1, 7, 13, 3 * n, 100}) {
+      const MatrixXd B = MatrixXd::NullaryExpr(n, k, [&] { return nhdyn_ref::uniform(rng, -3, 3); });
+      X = B;
+      f.solve_in_place(X);
+      CHECK(rel(X, M.llt().solve(B)) < 1e-12);
+    }
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> wide =
+        MatrixXd::NullaryExpr(n, 60, [&] { return nhdyn_ref::uniform(rng, -3, 3); });
+    const MatrixXd before = wide;
+    auto middle = wide.middleCols(5, 50);
+    f.solve_in_place(middle);
+    CHECK(rel(wide.middleCols(5, 50), M.llt().solve(before.middleCols(5, 50))) < 1e-12);
+    CHECK(wide.leftCols(5) == before.leftCols(5));  // the columns outside the view untouched
+    CHECK(wide.rightCols(5) == before.rightCols(5));
     // not positive definite (a leaf's diagonal, then the root's): refused
     MatrixXd bad = M;
     bad(n - 1, n - 1) = -1;
@@ -289,4 +310,84 @@ TEST_CASE("rne derivatives (analytic): wrong sizes and non-finite inputs are ref
   d.evaluate(z, z, z, out);
   CHECK(out.dq.rows() == 6);
   CHECK_THROWS_AS(d.evaluate(z, z, bad, out), input_error);
+}
+
+namespace {
+/// n bodies in a straight line along x (1 m apart), every axis z; each body's mass m at 0.25 m.
+tree<double> straight_arm(int n, double m, double inertia) {
+  std::vector<body<double>> B(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    auto& b = B[static_cast<std::size_t>(i)];
+    b.name = "b" + std::to_string(i);
+    b.joint_name = "j" + std::to_string(i);
+    b.parent = i - 1;
+    b.axis = vec3<double>(0, 0, 1);
+    b.p_PJ = vec3<double>(i ? 1.0 : 0.0, 0, 0);
+    b.mass = m;
+    b.com = vec3<double>(0.25, 0, 0);
+    b.inertia = Eigen::Matrix3d::Identity() * inertia;
+  }
+  return tree<double>(B, vec3<double>(0, 0, -9.81), "straight arm");
+}
+}  // namespace
+
+TEST_CASE("rne derivatives (analytic): an overflowing derivative is refused although tau is finite; huge finite ones are not") {
+  // The kernel sums every entry of dq, dqd and M as it writes them and the matrices are read
+  // again only when that sum is not finite. Each case below has τ finite, so only the
+  // derivative check can refuse it.
+  const VectorXd z = VectorXd::Zero(3);
+  const auto t = straight_arm(3, 1, 0.01);
+  const auto d = rne_derivatives(t);
+  wrench<double> w;
+  w.body = 3;  // the last body, at x = 2 m
+  w.force = vec3<double>(1e308, 0, 0);  // along the arm: no torque on any joint
+  w.point.setZero();
+  w.moment.setZero();
+  SECTION("a world-axes force: its variation overflows, on one body the diagonal alone") {
+    w.frame = wrench_frame::world;
+    const auto W = external_wrenches(t, {w});
+    CHECK(rne(t)(z, z, z, W).allFinite());
+    CHECK_THROWS_WITH(d(z, z, z, W), Catch::Contains("rne_derivatives (a derivative)") && Catch::Contains("overflow"));
+    const auto one = straight_arm(1, 1, 0.01);
+    const VectorXd z1 = VectorXd::Zero(1);
+    w.body = 1;
+    w.point = vec3<double>(2, 0, 0);  // 2 m out along the arm: p × f overflows
+    const auto W1 = external_wrenches(one, {w});
+    CHECK(rne(one)(z1, z1, z1, W1).allFinite());
+    CHECK_THROWS_WITH(rne_derivatives(one)(z1, z1, z1, W1), Catch::Contains("rne_derivatives (a derivative)"));
+  }
+  SECTION("a body-axes force: only off-diagonal entries overflow") {
+    w.frame = wrench_frame::body;
+    const auto W = external_wrenches(t, {w});
+    CHECK(rne(t)(z, z, z, W).allFinite());
+    // the kernel alone: the diagonal stays finite, ∂τ_j/∂q_2 (j = 0, 1: S_j · (S_2 ×* F)) does not
+    const auto L = detail::make_tree_links(t);
+    const std::vector<wrench<double>> ws{w};
+    const detail::wrench_forces<double, double> fx{&ws, &L};
+    rne_derivatives_result<double> out;
+    CHECK_FALSE(detail::rne_derivatives_dispatch<double>(L, t.gravity(), true, z, z, z, fx, out));
+    CHECK(out.dq.diagonal().allFinite());
+    CHECK_FALSE(std::isfinite(out.dq(1, 2)));
+    CHECK_THROWS_WITH(d(z, z, z, W), Catch::Contains("rne_derivatives (a derivative)"));
+  }
+  SECTION("entries near the largest double whose sum overflows: accepted, and equal CRBA's M") {
+    const auto heavy = straight_arm(5, 3e306, 3e304);
+    const VectorXd z5 = VectorXd::Zero(5);
+    const auto r = rne_derivatives(heavy, rne_options{.gravity = false})(z5, z5, z5);
+    CHECK(r.M.allFinite());
+    const auto L = detail::make_tree_links(heavy);
+    rne_derivatives_result<double> out;  // the kernel's own sum overflowed: the full check ran
+    CHECK_FALSE(detail::rne_derivatives_dispatch<double>(L, heavy.gravity(), false, z5, z5, z5,
+                                                         detail::wrench_forces<double, double>{}, out));
+    CHECK(out.M == r.M);
+    const MatrixXd C = mass_matrix(heavy)(z5);
+    CHECK(((r.M - C).cwiseAbs().array() <= 1e-12 * C.cwiseAbs().maxCoeff()).all());
+  }
+  SECTION("ordinary states take the one-pass check") {
+    const auto p = as_tree(presets::puma560<double>());
+    const auto L = detail::make_tree_links(p);
+    const VectorXd q = VectorXd::LinSpaced(6, -1, 1);
+    rne_derivatives_result<double> out;
+    CHECK(detail::rne_derivatives_dispatch<double>(L, p.gravity(), true, q, q, q, detail::wrench_forces<double, double>{}, out));
+  }
 }
