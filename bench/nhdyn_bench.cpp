@@ -488,7 +488,7 @@ void register_deriv(const std::string& model, const nhdyn::tree<double>& t) {
 /// deriv_fd/<model>/{fd, analytic, dual}: one holonomic forward dynamics call, its analytic
 /// A, B (forward_dynamics_derivatives: q̈, ∂q̈/∂(q, q̇), M⁻¹; `evaluate` into a reused result,
 /// as deriv_rne's analytic) and the same by duals
-/// (linearize_forward_dynamics, 3n directions).
+/// (linearize_forward_dynamics, 3n directions); deriv_fd_pair/<model>: fd and analytic paired.
 void register_deriv_fd(const std::string& model, const nhdyn::tree<double>& t) {
   const int n = t.dof();
   const state s = random_state(n);
@@ -500,16 +500,19 @@ void register_deriv_fd(const std::string& model, const nhdyn::tree<double>& t) {
   const auto A = a.state_space_model().A;
   agree(Eigen::Map<const Eigen::VectorXd>(A.data(), A.size()), Eigen::Map<const Eigen::VectorXd>(b.A.data(), b.A.size()),
         1e-9, "deriv_fd/" + model + ": analytic vs duals");
-  add("deriv_fd/" + model + "/fd", [fd, s, tau]() mutable {
+  const auto fd_call = [fd, s, tau]() mutable {
     opaque(s.q), opaque(s.qd), opaque(tau);
     auto r = fd(s.q, s.qd, tau);
     benchmark::DoNotOptimize(r);
-  });
-  add("deriv_fd/" + model + "/analytic", [d, s, tau, out = a]() mutable {  // into a reused result
+  };
+  const auto analytic_call = [d, s, tau, out = a]() mutable {  // into a reused result
     opaque(s.q), opaque(s.qd), opaque(tau);
     d.evaluate(s.q, s.qd, tau, out);
     benchmark::DoNotOptimize(out.dq.data());
-  });
+  };
+  add("deriv_fd/" + model + "/fd", fd_call);
+  add("deriv_fd/" + model + "/analytic", analytic_call);
+  add_paired("deriv_fd_pair/" + model, fd_call, analytic_call);
   add("deriv_fd/" + model + "/dual", [t, s, tau]() mutable {
     opaque(s.q), opaque(s.qd), opaque(tau);
     auto r = nhdyn::linearize_forward_dynamics(t, s.q, s.qd, tau);
@@ -520,7 +523,8 @@ void register_deriv_fd(const std::string& model, const nhdyn::tree<double>& t) {
 /// deriv_nh/<model>/{nh, analytic, dual}: one nonholonomic inverse dynamics call, its analytic
 /// ∂τ/∂(q, η, η̇) (inverse_dynamics_derivatives, `evaluate` into a reused result) and the same by duals
 /// (inverse_dynamics_linearizer, built once); deriv_nh_pair/<model>: nh and analytic paired;
-/// deriv_nh_fd/<model>/{fd, analytic, dual}: the constrained forward dynamics and its A, B.
+/// deriv_nh_fd/<model>/{fd, analytic, dual}: the constrained forward dynamics and its A, B;
+/// deriv_nh_fd_pair/<model>: fd and analytic paired.
 template <class C>
 void register_deriv_nh(const std::string& model, const nhdyn::tree<double>& t, const C& c) {
   const int n = c.dof(), m = c.m();
@@ -562,16 +566,19 @@ void register_deriv_nh(const std::string& model, const nhdyn::tree<double>& t, c
   const auto Ad = fdl(q, eta, tau).A;
   agree(Eigen::Map<const Eigen::VectorXd>(A.data(), A.size()), Eigen::Map<const Eigen::VectorXd>(Ad.data(), Ad.size()),
         1e-9, "deriv_nh_fd/" + model + ": analytic vs duals");
-  add("deriv_nh_fd/" + model + "/fd", [fd, q, eta, tau]() mutable {
+  const auto nh_fd_call = [fd, q, eta, tau]() mutable {
     opaque(q), opaque(eta), opaque(tau);
     auto r = fd(q, eta, tau);
     benchmark::DoNotOptimize(r);
-  });
-  add("deriv_nh_fd/" + model + "/analytic", [fdd, q, eta, tau, out = fdd(q, eta, tau)]() mutable {  // reused result
+  };
+  const auto nh_fd_analytic_call = [fdd, q, eta, tau, out = fdd(q, eta, tau)]() mutable {  // reused result
     opaque(q), opaque(eta), opaque(tau);
     fdd.evaluate(q, eta, tau, out);
     benchmark::DoNotOptimize(out.ss.A.data());
-  });
+  };
+  add("deriv_nh_fd/" + model + "/fd", nh_fd_call);
+  add("deriv_nh_fd/" + model + "/analytic", nh_fd_analytic_call);
+  add_paired("deriv_nh_fd_pair/" + model, nh_fd_call, nh_fd_analytic_call);
   add("deriv_nh_fd/" + model + "/dual", [fdl, q, eta, tau]() mutable {
     opaque(q), opaque(eta), opaque(tau);
     auto r = fdl(q, eta, tau);
