@@ -87,9 +87,9 @@ struct rne_deriv_scratch {
 ///
 /// Speed (double, g++ 12 -O3 -march=native, a random 48-body tree; harness, 2026-11-26):
 /// Ī's parallel-axis terms and Ẏ's block are written out entry by entry — as Eigen
-/// expressions (sums of outer products) they went through temporaries, ≈ 13 % of the call;
-/// the sum above replaces a second pass over the three matrices (≈ 10 %); the ancestor walk
-/// reads a packed parent array, not the links.
+/// expressions (sums of outer products) they went through temporaries, ≈ 12 % of the call;
+/// the sum above replaces a second pass over the three matrices (≈ 8 %); the ancestor walk
+/// reads a packed parent array, not the links (performance.md, note 14).
 template <class T, class Q, class QD, class QDD, class FX>
 bool tree_rne_derivatives_kernel(const std::vector<tree_link<T>>& L, const vec3<T>& g, bool gravity, const Q& q,
                                  const QD& qd, const QDD& qdd, const FX& fx, rne_derivatives_result<T>& out) {
