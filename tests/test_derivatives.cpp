@@ -52,8 +52,8 @@ void check_nh(const tree<double>& t, const C& c, std::mt19937_64& rng, const std
     for (auto* r : {&e, &ef.id}) {
       r->tau.setOnes(m + 2), r->dq.setOnes(m + 2, n + 3), r->deta.setOnes(1, 1), r->deta_dot.setOnes(m + 1, m + 1);
       r->dqd_dq.setOnes(2, 5), r->id.M.setOnes(n + 4, n + 4), r->id.dq.setOnes(1, 1);
-      r->work.x.setOnes(3, 3), r->work.xt.setOnes(n + 9, 2), r->work.stx.setOnes(m + 3, 1), r->work.jd.setOnes(7, 7);
-      r->work.nz.resize(3);
+      r->work.w.setOnes(3, 3), r->work.z.setOnes(n + 9, 2), r->work.stx.setOnes(m + 3, 1), r->work.jd.setOnes(7, 7);
+      r->work.se.setOnes(n + 1, m), r->work.st.nz.resize(3), r->work.st.singles.resize(2);
     }
     ef.ss.A.setOnes(3, 3), ef.ss.B.setOnes(4, 2), ef.eta_dot.setOnes(m + 5);
   }
@@ -95,6 +95,39 @@ TEST_CASE("nh derivatives: equal the dual linearizers on paper5, the mobile mani
   // holonomic: the derivatives of rne itself
   const auto puma = as_tree(presets::puma560<double>());
   check_nh(puma, holonomic<dynamic>{6}, rng, "puma560, holonomic");
+}
+
+TEST_CASE("nh derivatives: evaluate follows S's nonzeros as they vanish and reappear, and a result passed between constraints") {
+  std::mt19937_64 rng(21);
+  const auto p5 = as_tree(presets::paper5<double>().chain);
+  const differential_drive<double, dynamic> dd(5, 0, 1, 2, 0.0, -1.0);
+  const auto d = inverse_dynamics_derivatives(p5, dd);
+  const inverse_dynamics_linearizer lin(p5, dd);
+  VectorXd q = random_vec(rng, 5, 1.5);
+  const VectorXd eta = random_vec(rng, 4, 1), eta_dot = random_vec(rng, 4, 1);
+  nh_derivatives_result<double, Eigen::Dynamic> e;
+  // heading 0: sin ψ = 0, so S's (y, v) entry and Ṡ's (x, v) entry vanish; evaluate keeps the
+  // nonzero positions of its last call while they cover every nonzero, and reads S again when
+  // a nonzero appears outside them (0 → 0.7)
+  for (const double h : {0.0, 0.7, 0.0, -1.1, 0.0}) {
+    q(2) = h;
+    d.evaluate(q, eta, eta_dot, e);
+    INFO("heading " << h);
+    CHECK(e.J() == d(q, eta, eta_dot).J());
+    CHECK(rel(e.J(), lin(q, eta, eta_dot).J) < 1e-12);
+  }
+  // a result passed to another constraint of the same sizes (another layout of the base): its
+  // S is not read through the first one's
+  const differential_drive<double, dynamic> other(5, 1, 3, 2, 0.0, 1.0);
+  const auto d2 = inverse_dynamics_derivatives(p5, other);
+  q = random_vec(rng, 5, 1.5);
+  for (int k = 0; k < 2; ++k) {
+    d2.evaluate(q, eta, eta_dot, e);
+    CHECK(e.J() == d2(q, eta, eta_dot).J());
+    CHECK(rel(e.J(), inverse_dynamics_linearizer(p5, other)(q, eta, eta_dot).J) < 1e-12);
+    d.evaluate(q, eta, eta_dot, e);
+    CHECK(e.J() == d(q, eta, eta_dot).J());
+  }
 }
 
 TEST_CASE("nh derivatives: in 50 digits, equal 50-digit central differences of inverse_dynamics") {

@@ -16,8 +16,10 @@
 ///   dual numbers through the constraint's functions alone (O(n) each, no dynamics), and
 ///   ∂q̈/∂η = Ṡ(q, q̇) + Σ_{j∈D} ∂(Sη)/∂q_j S_j,: with Ṡ the derivative of S(q + ε q̇_D) (one
 ///   dual lane: Ṡ = Σ_j ∂S/∂q_j q̇_j, the time derivative the constraint concept defines), so
-///   every constraint type works as it is. The products with S and Sᵀ go over S's nonzeros
-///   (a base's few rows and the arm's identity columns: O(n²) for the whole Jacobian).
+///   every constraint type works as it is. τ's derivatives are formed in m rows from the
+///   start (Sᵀ∂v/∂q̇, SᵀM, then the products with S), every product with S or Sᵀ planned from
+///   S's nonzeros at the call: the arm's identity columns as block copies, a base's few
+///   columns as short sums (O(n²) for the whole Jacobian, about the cost of copying it).
 /// - `forward_dynamics_derivatives(t)(q, q̇, τ)`: q̈ and ∂q̈/∂q = −M⁻¹ ∂τ/∂q, ∂q̈/∂q̇ =
 ///   −M⁻¹ ∂τ/∂q̇, ∂q̈/∂τ = M⁻¹ (the implicit-function route: ∂τ/∂· at (q, q̇, FD(q, q̇, τ))).
 /// - `forward_dynamics_derivatives(t, c)(q, η, τ)`: η̇ and the state-space A = ∂f/∂x, B = ∂f/∂τ
@@ -28,6 +30,9 @@
 /// linearizers of analysis/linearize.hpp compute the same matrices another way (the tests'
 /// reference).
 #include <Eigen/LU>
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
 #include <vector>
 
 #include "../constraints/constraint.hpp"
@@ -42,6 +47,12 @@
 namespace nhdyn {
 
 namespace detail {
+/// A number no other function object constructed in this process has (copies keep theirs).
+inline std::uint64_t next_object_id() {
+  static std::atomic<std::uint64_t> last{0};
+  return ++last;
+}
+
 /// Every argument's scalar is S (the evaluate overloads: a reused result is in the model's
 /// scalar, and inputs of another are not silently converted to it).
 template <class S, class... X>
@@ -52,6 +63,140 @@ template <class T>
 struct s_nonzero {
   int r, c;
   T s;
+};
+
+/// S and Ṡ at one state as the chain rule's products use them: their nonzeros in column
+/// order, and the products Sᵀa and aS planned from them column by column of S — runs of at
+/// least four unit columns e_r (value exactly 1) whose c and r both step by one (an arm's
+/// identity) as block copies, other columns of one nonzero as one product, the rest as sums.
+/// Any constraint: the plan is read off S's values at each call.
+template <class T>
+struct st_plan {
+  struct run {
+    int c, r, len;
+  };
+  std::vector<s_nonzero<T>> nz, nz_dot;  ///< S's and Ṡ's nonzeros, in column order
+  std::vector<int> first, first_dot;     ///< column c's: nz[first[c] … first[c + 1]), and Ṡ's
+  std::vector<run> runs;                 ///< unit columns, in runs of four or more
+  std::vector<s_nonzero<T>> singles;     ///< the other columns of one nonzero
+  std::vector<int> general;              ///< the columns of none or several
+  int rows = -1;
+
+  /// Reads S and Ṡ off Se = S(q + ε q̇) (dual<T, 1> entries: values S, derivatives Ṡ). The
+  /// last call's nonzero positions are kept while no nonzero lies outside them — counted over
+  /// the whole matrix: the nonzeros at the kept positions equal all of its nonzeros (an entry
+  /// zero at a kept position only adds a zero term) — else Se is scanned again.
+  template <class SE>
+  void read(const SE& Se_in) {
+    const auto& Se = Se_in.eval();  // a constraint's S may be an expression (holonomic: I)
+    const int n = static_cast<int>(Se.rows()), m = static_cast<int>(Se.cols());
+    const auto nonzero = [](const auto& x) { return int(!is_exact_zero(x)); };
+    bool keep = n == rows && static_cast<int>(first.size()) == m + 1;
+    if (keep) {
+      int all = 0, at = 0;
+      const auto* p = Se.data();
+      for (Eigen::Index k = 0; k < Se.size(); ++k) all += nonzero(p[k].value()) + nonzero(p[k].derivative(0));
+      for (auto& e : nz) at += nonzero(e.s = T(Se(e.r, e.c).value()));
+      for (auto& e : nz_dot) at += nonzero(e.s = T(Se(e.r, e.c).derivative(0)));
+      keep = all == at;
+    }
+    if (!keep) {
+      rows = n;
+      nz.clear(), nz_dot.clear();
+      for (int c = 0; c < m; ++c)
+        for (int r = 0; r < n; ++r) {
+          const auto& e = Se(r, c);
+          if (nonzero(e.value())) nz.push_back({r, c, T(e.value())});
+          if (nonzero(e.derivative(0))) nz_dot.push_back({r, c, T(e.derivative(0))});
+        }
+      starts(nz, m, first);
+      starts(nz_dot, m, first_dot);
+    }
+    plan(m);
+  }
+  /// d = Sᵀa (a: n rows, d: a writable expression of m rows and a's columns; both with
+  /// contiguous columns).
+  template <class A, class Dst>
+  void St_times(const A& a, Dst&& d) const {
+    static_assert(A::InnerStrideAtCompileTime == 1 && std::decay_t<Dst>::InnerStrideAtCompileTime == 1);
+    const Eigen::Index cols = a.cols();
+    for (const run& u : runs)
+      for (Eigen::Index j = 0; j < cols; ++j) copy_short(&a.coeffRef(u.r, j), u.len, &d.coeffRef(u.c, j));
+    for (const auto& e : singles)
+      for (Eigen::Index j = 0; j < cols; ++j) d.coeffRef(e.c, j) = e.s * a.coeffRef(e.r, j);
+    for (const int c : general) {
+      const int k0 = first[std::size_t(c)], k1 = first[std::size_t(c) + 1];
+      for (Eigen::Index j = 0; j < cols; ++j) {
+        const T* from = &a.coeffRef(0, j);
+        T x(0);
+        for (int k = k0; k < k1; ++k) x += nz[std::size_t(k)].s * from[nz[std::size_t(k)].r];
+        d.coeffRef(c, j) = x;
+      }
+    }
+  }
+  /// d = aS (a: n columns, d: a writable expression of a's rows and m columns; both with
+  /// contiguous columns).
+  template <class A, class Dst>
+  void times_S(const A& a, Dst&& d) const {
+    static_assert(A::InnerStrideAtCompileTime == 1 && std::decay_t<Dst>::InnerStrideAtCompileTime == 1);
+    const int n = static_cast<int>(a.rows());
+    for (const run& u : runs)
+      for (int k = 0; k < u.len; ++k) copy_short(&a.coeffRef(0, u.r + k), n, &d.coeffRef(0, u.c + k));
+    for (const auto& e : singles) {
+      const T* from = &a.coeffRef(0, e.r);
+      T* to = &d.coeffRef(0, e.c);
+      for (int i = 0; i < n; ++i) to[i] = e.s * from[i];
+    }
+    for (const int c : general) {
+      T* to = &d.coeffRef(0, c);
+      std::fill_n(to, n, T(0));
+      for (int k = first[std::size_t(c)]; k < first[std::size_t(c) + 1]; ++k) {
+        const T s = nz[std::size_t(k)].s;
+        const T* from = &a.coeffRef(0, nz[std::size_t(k)].r);
+        for (int i = 0; i < n; ++i) to[i] += s * from[i];
+      }
+    }
+  }
+
+ private:
+  void plan(int m) {
+    runs.clear(), singles.clear(), general.clear();
+    const auto count = [&](int c) { return first[std::size_t(c) + 1] - first[std::size_t(c)]; };
+    const auto unit_row = [&](int c) {  // r when S's column c is e_r, else −1
+      const auto& e = nz[std::size_t(first[std::size_t(c)])];
+      return count(c) == 1 && is_exact_zero(T(e.s - T(1))) ? e.r : -1;
+    };
+    for (int c = 0; c < m;) {
+      const int r0 = unit_row(c);
+      int len = 1;
+      while (r0 >= 0 && c + len < m && unit_row(c + len) == r0 + len) ++len;
+      if (r0 >= 0 && len >= 4) {
+        runs.push_back({c, r0, len});
+        c += len;
+        continue;
+      }
+      for (const int end = c + len; c < end; ++c) {
+        if (count(c) == 1)
+          singles.push_back(nz[std::size_t(first[std::size_t(c)])]);
+        else
+          general.push_back(c);
+      }
+    }
+  }
+  static void starts(const std::vector<s_nonzero<T>>& z, int m, std::vector<int>& f) {
+    f.assign(static_cast<std::size_t>(m) + 1, 0);
+    for (const auto& e : z) ++f[static_cast<std::size_t>(e.c) + 1];
+    for (int c = 0; c < m; ++c) f[std::size_t(c) + 1] += f[std::size_t(c)];
+  }
+  /// to[0 … len) = from[0 … len) (not overlapping) in fixed-size chunks of four, the last one
+  /// overlapping the one before: for the few dozen entries of a column, Eigen's and memmove's
+  /// loops spend more on their set-up and tails than on the copy.
+  static void copy_short(const T* from, int len, T* to) {
+    using V = Eigen::Matrix<T, 4, 1>;
+    int i = 0;
+    for (; i + 4 <= len; i += 4) Eigen::Map<V>(to + i) = Eigen::Map<const V>(from + i);
+    if (i < len) Eigen::Map<V>(to + len - 4) = Eigen::Map<const V>(from + len - 4);  // len ≥ 4
+  }
 };
 }  // namespace detail
 
@@ -73,13 +218,15 @@ struct nh_derivatives_result {
     return j;
   }
   /// Scratch of the computation, kept by evaluate for its next call (empty in a result that
-  /// operator() returns): S's and Ṡ's nonzeros, the constraint's [∂q̇/∂q_j; ∂q̈/∂q_j;
-  /// ∂(Pv)/∂q_j] for j ∈ D, X = [∂v/∂q + …  ∂v/∂η  ∂v/∂η̇  v] (n × (n + 2m + 1)), Xᵀ, XᵀS
-  /// and SᵀX.
+  /// operator() returns): S(q + ε q̇) where the constraint writes into a matrix (S_into), S's
+  /// and Ṡ's nonzeros and Sᵀ's plan, the constraint's [∂q̇/∂q_j; ∂q̈/∂q_j; ∂(Pv)/∂q_j] for
+  /// j ∈ D, W = Sᵀ ∂v/∂q̇, Z = Sᵀ M and, where SᵀE ≠ I, Sᵀ[X_q X_η X_η̇ v].
   struct scratch {
-    std::vector<detail::s_nonzero<T>> nz, nz_dot;
-    Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> jd, x, xt, stxt;
-    Eigen::Matrix<T, M, Eigen::Dynamic> stx;
+    detail::st_plan<T> st;
+    Eigen::Matrix<dual<T, 1>, Eigen::Dynamic, Eigen::Dynamic> se;
+    std::uint64_t se_owner = 0;  ///< the function object (its constraint) that wrote se
+    Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> jd;
+    Eigen::Matrix<T, M, Eigen::Dynamic> w, z, stx;
   } work;
 };
 
@@ -95,8 +242,10 @@ class inverse_dynamics_derivatives_fn {
     if (c.dof() != t.dof())
       throw input_error("inverse_dynamics_derivatives: the constraint is for " + std::to_string(c.dof()) +
                         " joints, model '" + t.name() + "' has " + std::to_string(t.dof()));
-    for (int j = 0; j < c.dof(); ++j)
-      if (constraint_depends_on(c, j)) cols_.push_back(j);
+    for (int j = 0; j < c.dof(); ++j) {
+      dcol_.push_back(constraint_depends_on(c, j) ? static_cast<int>(cols_.size()) : -1);
+      if (dcol_.back() >= 0) cols_.push_back(j);
+    }
   }
   int dof() const { return c_.dof(); }
   int m() const { return c_.m(); }
@@ -145,100 +294,115 @@ class inverse_dynamics_derivatives_fn {
     const int n = c_.dof(), m = c_.m();
     const vecN<T, N> q = q_in.template cast<T>();
     const vecN<T, M> eta = eta_in.template cast<T>(), eta_dot = eta_dot_in.template cast<T>();
-    // the lift and rne's derivatives there
+    auto& w = out.work;
+    // q̇ = Sη; S and Ṡ at once: S depends on q_D alone, so Ṡ(q, q̇) = Σ_{j∈D} ∂S/∂q_j q̇_j is
+    // the derivative of S(q + ε q̇_D) (one dual lane; the time derivative the concept defines)
     const vecN<T, N> qd = apply_S(c_, q, eta);
-    vecN<T, N> qdd = apply_S(c_, q, eta_dot);
-    qdd += apply_Sdot(c_, q, qd, eta);
+    using D1 = dual<T, 1>;
+    vecN<D1, N> q_eps = q.template cast<D1>();
+    for (const int j : cols_) q_eps(j).derivative(0) = qd(j);
+    auto& st = w.st;
+    if constexpr (has_S_into<C, vecN<D1, N>, decltype(w.se)>) {
+      // into the S(q + ε q̇) of this function object's last call (zeros at the first): the
+      // constraint writes only the entries that can be nonzero
+      if (w.se_owner != id_ || w.se.rows() != n || w.se.cols() != m) {
+        w.se.setZero(n, m);
+        w.se_owner = id_;
+      }
+      c_.S_into(q_eps, w.se);
+      st.read(w.se);
+    } else {
+      st.read(c_.S(q_eps));
+    }
+    // q̈ = Sη̇ + Ṡη, and rne's derivatives at the lifted state
+    vecN<T, N> qdd = vecN<T, N>::Zero(n);
+    for (const auto& e : st.nz) qdd(e.r) += e.s * eta_dot(e.c);
+    for (const auto& e : st.nz_dot) qdd(e.r) += e.s * eta(e.c);
     derivatives(q, qd, qdd, out.id);
     const auto& r = out.id;
     // The constraint's pieces, by duals along q_j for the joints it depends on (j ∈ D): rows
     // [∂q̇/∂q_j; ∂q̈/∂q_j; ∂(P v)/∂q_j] with v held.
     const vecN<T, N>& v = r.tau;
-    const auto along_q = [&](const auto& x) {
-      using Dl = typename std::decay_t<decltype(x)>::Scalar;
-      const vecN<Dl, M> e = eta.template cast<Dl>(), ed = eta_dot.template cast<Dl>();
-      const vecN<Dl, N> xd = apply_S(c_, x, e);
-      vecN<Dl, N> xdd = apply_S(c_, x, ed);
-      xdd += apply_Sdot(c_, x, xd, e);
-      const vecN<Dl, M> pv = detail::solve_StE(c_, x, apply_St(c_, x, vecN<Dl, N>(v.template cast<Dl>())));
-      Eigen::Matrix<Dl, Eigen::Dynamic, 1> y(2 * n + m);
-      y << xd, xdd, pv;
-      return y;
-    };
-    // Jd: column k is the derivative along q_{D_k} (one dual pass per 4 joints of D)
     const int nd = static_cast<int>(cols_.size());
-    auto& Jd = out.work.jd;
+    auto& Jd = w.jd;
     Jd.resize(2 * n + m, nd);
-    if (nd > 0) {
-      using D4 = dual<T, 4>;
-      vecN<D4, N> xd(n);
-      for (int c0 = 0; c0 < nd; c0 += 4) {
-        for (int i = 0; i < n; ++i) xd(i) = D4(q(i));
-        for (int k = 0; k < 4 && c0 + k < nd; ++k) xd(cols_[static_cast<std::size_t>(c0 + k)]).derivative(k) = T(1);
-        const auto y = along_q(xd);
-        for (Eigen::Index rr = 0; rr < y.size(); ++rr)
-          for (int k = 0; k < 4 && c0 + k < nd; ++k) Jd(rr, c0 + k) = y(rr).derivative(k);
+    // Jd: column k is the derivative along q_{D_k}: one dual pass of K lanes per K joints of D
+    // (K = 1, 2 or 4: a base's heading, a bicycle's heading and steering, more)
+    const auto passes = [&]<int K>(std::integral_constant<int, K>) {
+      using DK = dual<T, K>;
+      vecN<DK, N> x(n), xd(n), xdd(n);
+      const auto put = [&](int row0, int c0, const auto& y) {
+        for (Eigen::Index i = 0; i < y.size(); ++i)
+          for (int k = 0; k < K && c0 + k < nd; ++k) Jd(row0 + i, c0 + k) = y(i).derivative(k);
+      };
+      for (int c0 = 0; c0 < nd; c0 += K) {
+        for (int i = 0; i < n; ++i) x(i) = DK(q(i));
+        for (int k = 0; k < K && c0 + k < nd; ++k) x(cols_[static_cast<std::size_t>(c0 + k)]).derivative(k) = T(1);
+        if constexpr (requires { c_.lift_into(x, eta, eta_dot, xd, xdd); }) {
+          c_.lift_into(x, eta, eta_dot, xd, xdd);  // the lift in one pass (constraints/stages.hpp)
+        } else {
+          const vecN<DK, M> e = eta.template cast<DK>(), ed = eta_dot.template cast<DK>();
+          xd = apply_S(c_, x, e);
+          xdd = apply_S(c_, x, ed);
+          xdd += apply_Sdot(c_, x, xd, e);
+        }
+        put(0, c0, xd);
+        put(n, c0, xdd);
+        put(2 * n, c0, detail::solve_StE(c_, x, apply_St(c_, x, vecN<DK, N>(v.template cast<DK>()))));
       }
-    }
-    // S and Ṡ at once: S depends on q_D alone, so Ṡ(q, q̇) = Σ_{j∈D} ∂S/∂q_j q̇_j is the
-    // derivative of S(q + ε q̇_D) (one dual lane; the time derivative the concept defines).
-    using D1 = dual<T, 1>;
-    vecN<D1, N> q_eps = q.template cast<D1>();
-    for (const int j : cols_) q_eps(j).derivative(0) = qd(j);
-    const auto S_eps = c_.S(q_eps);
-    // S's nonzeros (r, c, S_rc): the products with S and Sᵀ below cost one row or column per
-    // nonzero (a base's few rows and the arm's identity), any constraint
-    auto& nz = out.work.nz;
-    auto& nz_dot = out.work.nz_dot;
-    nz.clear(), nz_dot.clear();
-    for (int cc = 0; cc < m; ++cc)
-      for (int rr = 0; rr < n; ++rr) {
-        const D1& e = S_eps(rr, cc);
-        if (!is_exact_zero(e.value())) nz.push_back({rr, cc, T(e.value())});
-        if (!is_exact_zero(e.derivative(0))) nz_dot.push_back({rr, cc, T(e.derivative(0))});
-      }
-    // X = [X_q  X_η  X_η̇  v] (n × (n + 2m + 1)), then τ's derivatives = (SᵀE)⁻¹ Sᵀ X (one solve):
+    };
+    if (nd == 1)
+      passes(std::integral_constant<int, 1>{});
+    else if (nd == 2)
+      passes(std::integral_constant<int, 2>{});
+    else if (nd > 2)
+      passes(std::integral_constant<int, 4>{});
+    // τ's derivatives = (SᵀE)⁻¹ Sᵀ [X_q  X_η  X_η̇  v] with
     //   X_q = V_q + V_q̇ ∂q̇/∂q + M ∂q̈/∂q (the middle terms in columns D only),
     //   X_η = V_q̇ S + M ∂q̈/∂η, ∂q̈/∂η = ∂(Ṡ(q, Sη)η)/∂η = Ṡ(q, q̇) + Σ_{j∈D} ∂(Sη)/∂q_j S_j,:
     //         (Ṡ = Σ_j ∂S/∂q_j q̇_j is linear in q̇ and S depends on q_D alone),
-    //   X_η̇ = M S.
-    auto& X = out.work.x;
-    X.resize(n, n + 2 * m + 1);
-    X.leftCols(n) = r.dq;
-    X.rightCols(2 * m + 1).setZero();
-    auto Xq = X.leftCols(n);
-    auto Xe = X.middleCols(n, m);
-    auto Xed = X.middleCols(n + m, m);
-    for (int k = 0; k < nd; ++k)
-      for (int rr = 0, j = cols_[static_cast<std::size_t>(k)]; rr < n; ++rr) {
-        const T a1 = Jd(rr, k), a2 = Jd(n + rr, k);
-        if (!is_exact_zero(a1)) Xq.col(j) += a1 * r.dqd.col(rr);
-        if (!is_exact_zero(a2)) Xq.col(j) += a2 * r.M.col(rr);
-      }
-    for (const auto& e : nz) {
-      Xe.col(e.c) += e.s * r.dqd.col(e.r);
-      Xed.col(e.c) += e.s * r.M.col(e.r);
-    }
-    for (const auto& e : nz_dot) Xe.col(e.c) += e.s * r.M.col(e.r);
-    for (int k = 0; k < nd; ++k)
-      for (const auto& e : nz)
-        if (e.r == cols_[static_cast<std::size_t>(k)])
+    //   X_η̇ = M S,
+    // in m rows from the start: with W = Sᵀ V_q̇ and Z = Sᵀ M (m × n),
+    //   Sᵀ X_q = Sᵀ V_q + W ∂q̇/∂q + Z ∂q̈/∂q,   Sᵀ X_η = W S + Z ∂q̈/∂η,   Sᵀ X_η̇ = Z S,
+    // each product with S or Sᵀ a block copy per run of S's unit columns (st_plan).
+    auto& W = w.w;
+    auto& Z = w.z;
+    W.resize(m, n);
+    Z.resize(m, n);
+    st.St_times(r.dqd, W);
+    st.St_times(r.M, Z);
+    const auto fill = [&](auto&& Dq, auto&& De, auto&& Ded, auto&& Tau) {
+      st.St_times(r.dq, Dq);
+      for (int k = 0; k < nd; ++k)
+        for (int rr = 0, j = cols_[static_cast<std::size_t>(k)]; rr < n; ++rr) {
+          if (const T a1 = Jd(rr, k); !is_exact_zero(a1)) Dq.col(j) += a1 * W.col(rr);
+          if (const T a2 = Jd(n + rr, k); !is_exact_zero(a2)) Dq.col(j) += a2 * Z.col(rr);
+        }
+      st.times_S(W, De);
+      for (const auto& e : st.nz_dot) De.col(e.c) += e.s * Z.col(e.r);
+      for (const auto& e : st.nz)
+        if (const int k = dcol_[std::size_t(e.r)]; k >= 0)
           for (int rr = 0; rr < n; ++rr)
-            if (!is_exact_zero(Jd(rr, k))) Xe.col(e.c) += (Jd(rr, k) * e.s) * r.M.col(rr);
-    X.col(n + 2 * m) = v;
-    // Sᵀ X = (Xᵀ S)ᵀ: on Xᵀ each nonzero of S is one vectorised column operation
-    auto& Xt = out.work.xt;
-    Xt = X.transpose();
-    auto& StXt = out.work.stxt;
-    StXt.setZero(X.cols(), m);
-    for (const auto& e : nz) StXt.col(e.c) += e.s * Xt.col(e.r);
-    auto& StX = out.work.stx;
-    StX = StXt.transpose();
-    StX = detail::solve_StE(c_, q, std::move(StX));
-    out.tau = StX.col(n + 2 * m);
-    out.dq = StX.leftCols(n);
-    out.deta = StX.middleCols(n, m);
-    out.deta_dot = StX.middleCols(n + m, m);
+            if (const T a = Jd(rr, k); !is_exact_zero(a)) De.col(e.c) += (a * e.s) * Z.col(rr);
+      st.times_S(Z, Ded);
+      st.St_times(v, Tau);
+    };
+    out.tau.resize(m);
+    out.dq.resize(m, n);
+    out.deta.resize(m, m);
+    out.deta_dot.resize(m, m);
+    if constexpr (detail::projection_is_St<C, vecN<T, N>>) {
+      fill(out.dq, out.deta, out.deta_dot, out.tau);
+    } else {
+      auto& StX = w.stx;
+      StX.resize(m, n + 2 * m + 1);
+      fill(StX.leftCols(n), StX.middleCols(n, m), StX.middleCols(n + m, m), StX.col(n + 2 * m));
+      StX = detail::solve_StE(c_, q, std::move(StX));
+      out.tau = StX.col(n + 2 * m);
+      out.dq = StX.leftCols(n);
+      out.deta = StX.middleCols(n, m);
+      out.deta_dot = StX.middleCols(n + m, m);
+    }
     out.dqd_dq.setZero(n, n);
     for (int k = 0; k < nd; ++k) {
       const int j = cols_[static_cast<std::size_t>(k)];
@@ -249,7 +413,9 @@ class inverse_dynamics_derivatives_fn {
 
   rne_derivatives_fn<S> d_;
   C c_;
-  std::vector<int> cols_;
+  std::uint64_t id_ = detail::next_object_id();  // copies share it: they hold the same constraint
+  std::vector<int> cols_;  // D: the joints the constraint depends on
+  std::vector<int> dcol_;  // per joint, its index in cols_ (−1 if not in D)
 };
 
 template <class S, class C>

@@ -112,16 +112,23 @@ struct bicycle {
   template <class Q>
   auto S(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<Sc, typename Q::Scalar>;
+    matrix<T, N, m_at_compile_time> s = matrix<T, N, m_at_compile_time>::Zero(n, n - 2);
+    S_into(q, s);
+    return s;
+  }
+  /// S(q) into s (n × m), which holds zeros or S at another q: only the entries that can be
+  /// nonzero are written (no allocation, no zeroing; `has_S_into`).
+  template <class Q, class Sm>
+  void S_into(const Eigen::MatrixBase<Q>& q, Eigen::MatrixBase<Sm>& s) const {
+    using T = promote_t<Sc, typename Q::Scalar>;
     const auto p = detail::sincos_of(T(q(heading)));
     const auto d = steering(T(q(steer)));
-    matrix<T, N, m_at_compile_time> s = matrix<T, N, m_at_compile_time>::Zero(n, n - 2);
     s(x, 0) = p.c;
     s(y, 0) = p.s;
     s(heading, 0) = d.s / (T(wheelbase) * d.c);
     s(steer, 1) = T(1);
     for (int j = 0, c = 2; j < n; ++j)
       if (!is_base_or_steer(j)) s(j, c++) = T(1);
-    return s;
   }
   template <class Q, class QD>
   auto Sdot(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd) const {

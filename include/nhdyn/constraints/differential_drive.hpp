@@ -105,6 +105,14 @@ struct differential_drive {
   auto S(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<Sc, typename Q::Scalar>;
     matrix<T, N, m_at_compile_time> s = matrix<T, N, m_at_compile_time>::Zero(n, n - 1);
+    S_into(q, s);
+    return s;
+  }
+  /// S(q) into s (n × m), which holds zeros or S at another q: only the entries that can be
+  /// nonzero are written (no allocation, no zeroing; `has_S_into`).
+  template <class Q, class Sm>
+  void S_into(const Eigen::MatrixBase<Q>& q, Eigen::MatrixBase<Sm>& s) const {
+    using T = promote_t<Sc, typename Q::Scalar>;
     const auto p = sincos_psi(T(q(heading)));
     const int lo = std::min(x, y), hi = std::max(x, y);
     int c = 0;
@@ -117,7 +125,6 @@ struct differential_drive {
         s(j, c++) = T(1);
       }
     }
-    return s;
   }
   template <class Q, class QD>
   auto Sdot(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd) const {

@@ -130,9 +130,17 @@ struct rolling_wheels {
   template <class Q>
   auto S(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<Sc, typename Q::Scalar>;
+    matrix<T, N, m_at_compile_time> s = matrix<T, N, m_at_compile_time>::Zero(n, n - 3);
+    S_into(q, s);
+    return s;
+  }
+  /// S(q) into s (n × m), which holds zeros or S at another q: only the entries that can be
+  /// nonzero are written (no allocation, no zeroing; `has_S_into`).
+  template <class Q, class Sm>
+  void S_into(const Eigen::MatrixBase<Q>& q, Eigen::MatrixBase<Sm>& s) const {
+    using T = promote_t<Sc, typename Q::Scalar>;
     const auto p = detail::sincos_of(T(q(heading)));
     const wheel_map k = map();
-    matrix<T, N, m_at_compile_time> s = matrix<T, N, m_at_compile_time>::Zero(n, n - 3);
     s(x, 0) = p.c * T(k.uL) - p.s * T(k.lL);
     s(y, 0) = p.s * T(k.uL) + p.c * T(k.lL);
     s(heading, 0) = T(k.wL);
@@ -143,7 +151,6 @@ struct rolling_wheels {
     s(right, 1) = T(1);
     for (int j = 0, c = 2; j < n; ++j)
       if (!is_base_or_wheel(j)) s(j, c++) = T(1);
-    return s;
   }
   template <class Q, class QD>
   auto Sdot(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd) const {

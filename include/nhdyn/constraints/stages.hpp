@@ -108,6 +108,10 @@ lift_fn<C> lift(C c) {
 }
 
 namespace detail {
+/// Whether the projection P = (SᵀE)⁻¹Sᵀ is Sᵀ itself: SᵀS = I and no input map, or SᵀE = I.
+template <class C, class Q>
+inline constexpr bool projection_is_St = (C::orthonormal_S && !has_input_map<C, Q>) || has_identity_StE<C>;
+
 /// (SᵀE)⁻¹ r, for a right-hand side r of m rows (a vector, or a matrix of columns; taken by
 /// value: with SᵀS = I and no E it is the answer, returned without a copy).
 template <class C, class Q, class R>
@@ -116,9 +120,9 @@ auto solve_StE(const C& c, const Eigen::MatrixBase<Q>& q, R r) {
   constexpr int M = C::m_at_compile_time;
   using P = Eigen::Matrix<T, M, R::ColsAtCompileTime>;  // vecN<T, M> for a vector r
   constexpr bool has_E = has_input_map<C, Q>;
-  if constexpr (((C::orthonormal_S && !has_E) || has_identity_StE<C>) && std::is_same_v<R, P>) {
+  if constexpr (projection_is_St<C, Q> && std::is_same_v<R, P>) {
     return r;
-  } else if constexpr ((C::orthonormal_S && !has_E) || has_identity_StE<C>) {
+  } else if constexpr (projection_is_St<C, Q>) {
     return P(r);
   } else {
     const auto S = c.S(q);
