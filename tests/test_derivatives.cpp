@@ -203,7 +203,66 @@ TEST_CASE("forward dynamics derivatives (holonomic): equal the duals, with armat
     CHECK(rel(aw.dq, Jw.leftCols(n)) < 1e-10);
     CHECK(rel(aw.dqd, Jw.middleCols(n, n)) < 1e-10);
     CHECK(rel(aw.Minv, Jw.rightCols(n)) < 1e-10);
+    // evaluate with the wrenches, into the result reused above: the call's numbers
+    forward_dynamics_derivatives(t).evaluate(q, qd, tau, w, reused);
+    CHECK(reused.dq == aw.dq);
+    CHECK(reused.dqd == aw.dqd);
+    CHECK(reused.Minv == aw.Minv);
+    CHECK(reused.qdd == aw.qdd);
   }
+}
+
+TEST_CASE("nh derivatives with external wrenches: equal the duals of lift | rne | w | project; evaluate = the call") {
+  std::mt19937_64 rng(23);
+  const auto r = io::load_robot_file(source("examples/robots/mobile_manipulator_bicycle.json"));
+  REQUIRE(r.constraint);
+  std::visit([&](const auto& c) {
+    const tree<double>& t = r.model;
+    const int n = c.dof(), m = c.m();
+    wrench<double> w1, w2;
+    w1.body = n, w1.force = random_vec(rng, 3, 20), w1.point = random_vec(rng, 3, 0.3);
+    w2.body = 4, w2.moment = random_vec(rng, 3, 5), w2.force = random_vec(rng, 3, 7), w2.frame = wrench_frame::body;
+    const auto w = external_wrenches(t, {w1, w2});
+    const VectorXd q = random_vec(rng, n, 1.5), eta = random_vec(rng, m, 1), eta_dot = random_vec(rng, m, 1),
+                   tau = random_vec(rng, m, 5);
+    const auto d = inverse_dynamics_derivatives(t, c);
+    const auto a = d(q, eta, eta_dot, w);
+    // the reference: duals through project ∘ (rne − Q_ext) ∘ lift with the same wrenches
+    const auto id = lift(c) | rne(t) | w | project(c);
+    VectorXd x(n + 2 * m);
+    x << q, eta, eta_dot;
+    const MatrixXd J = jacobian(
+        [&](const auto& z) {
+          using D = typename std::decay_t<decltype(z)>::Scalar;
+          return Eigen::Matrix<D, Eigen::Dynamic, 1>(id(z.head(n), z.segment(n, m), z.tail(m)));
+        },
+        x);
+    CHECK(rel(a.J(), J) < 1e-12);
+    CHECK(rel(a.J(), d(q, eta, eta_dot).J()) > 1e-6);  // the wrenches change the derivatives
+    nh_derivatives_result<double, Eigen::Dynamic> e;
+    d.evaluate(q, eta, eta_dot, e);  // first without: the scratch of another call
+    d.evaluate(q, eta, eta_dot, w, e);
+    CHECK(e.J() == a.J());
+    CHECK(e.tau == a.tau);
+    // the constrained forward dynamics' A, B with the wrenches, and evaluate
+    const auto f = forward_dynamics_derivatives(t, c);
+    const auto fa = f(q, eta, tau, w);
+    nh_fd_derivatives_result<double, Eigen::Dynamic> fe;
+    f.evaluate(q, eta, tau, w, fe);
+    CHECK(fe.ss.A == fa.ss.A);
+    CHECK(fe.ss.B == fa.ss.B);
+    CHECK(fe.eta_dot == fa.eta_dot);
+    // and rne's own derivatives with the wrenches
+    const auto rd = rne_derivatives(t);
+    const VectorXd v1 = random_vec(rng, n, 1), v2 = random_vec(rng, n, 1);
+    const auto ra = rd(q, v1, v2, w);
+    rne_derivatives_result<double> re;
+    rd.evaluate(q, v1, v2, w, re);
+    CHECK(re.dq == ra.dq);
+    CHECK(re.dqd == ra.dqd);
+    CHECK(re.M == ra.M);
+    CHECK(re.tau == ra.tau);
+  }, *r.constraint);
 }
 
 TEST_CASE("derivatives: a constraint for another model, and bad inputs, are refused by name") {

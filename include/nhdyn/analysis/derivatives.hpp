@@ -233,8 +233,8 @@ struct nh_derivatives_result {
 
 /// ∂τ/∂(q, η, η̇) of the nonholonomic inverse dynamics of a tree and any constraint (see the
 /// file comment): `inverse_dynamics_derivatives(t, c)(q, eta, eta_dot [, w])`;
-/// `evaluate(q, eta, eta_dot, out)` reuses out's matrices and scratch (inputs in the model's
-/// scalar, no wrenches).
+/// `evaluate(q, eta, eta_dot [, w], out)` reuses out's matrices and scratch (inputs and
+/// wrenches in the model's scalar).
 template <class S, class C>
 class inverse_dynamics_derivatives_fn {
  public:
@@ -280,6 +280,14 @@ class inverse_dynamics_derivatives_fn {
                 nh_derivatives_result<S, C::m_at_compile_time>& out) const {
     run(q, eta, eta_dot, out,
         [&](const auto& x, const auto& xd, const auto& xdd, auto& r) { d_.evaluate(x, xd, xdd, r); });
+  }
+  /// …with external wrenches in the model's scalar.
+  template <class Q, class E, class ED, class Kin>
+    requires detail::in_scalar<S, Q, E, ED>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
+                const external_wrenches_fn<Kin, S>& w, nh_derivatives_result<S, C::m_at_compile_time>& out) const {
+    run(q, eta, eta_dot, out,
+        [&](const auto& x, const auto& xd, const auto& xdd, auto& r) { d_.evaluate(x, xd, xdd, w, r); });
   }
 
  private:
@@ -453,8 +461,8 @@ struct fd_derivatives_result {
 /// q̈ by forward_dynamics(t) (its checks and its choice of algorithm); M⁻¹ and the products
 /// with it by the tree-sparse factorisation M = LᵀL (dynamics/tree_factor.hpp) of the M that
 /// rne_derivatives returns (refused, naming the model, when M is not positive definite).
-/// `evaluate(q, qd, tau, out)` reuses out's matrices and scratch from call to call (inputs in
-/// the model's scalar, no wrenches); q̈ comes from forward_dynamics as a new vector.
+/// `evaluate(q, qd, tau [, w], out)` reuses out's matrices and scratch from call to call
+/// (inputs and wrenches in the model's scalar); q̈ comes from forward_dynamics as a new vector.
 template <class S>
 class fd_derivatives_fn {
  public:
@@ -486,6 +494,15 @@ class fd_derivatives_fn {
                 fd_derivatives_result<S>& out) const {
     out.qdd = fd_(q, qd, tau);
     d_.evaluate(q, qd, out.qdd, out.id);
+    solve(out);
+  }
+  /// …with external wrenches in the model's scalar.
+  template <class Q, class QD, class TAU, class Kin>
+    requires detail::in_scalar<S, Q, QD, TAU>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
+                const external_wrenches_fn<Kin, S>& w, fd_derivatives_result<S>& out) const {
+    out.qdd = fd_(q, qd, tau, w);
+    d_.evaluate(q, qd, out.qdd, w, out.id);
     solve(out);
   }
 
@@ -547,8 +564,8 @@ struct nh_fd_derivatives_result {
 
 /// A, B of a constrained tree's forward dynamics, analytically:
 /// `forward_dynamics_derivatives(t, c)(q, eta, tau [, w])`; `evaluate(q, eta, tau, out)`
-/// reuses out's inverse-dynamics matrices and scratch (inputs in the model's scalar, no
-/// wrenches).
+/// reuses out's inverse-dynamics matrices and scratch (inputs and wrenches in the model's
+/// scalar).
 template <class S, class C>
 class nh_fd_derivatives_fn {
  public:
@@ -585,6 +602,15 @@ class nh_fd_derivatives_fn {
                 nh_fd_derivatives_result<S, C::m_at_compile_time>& out) const {
     const auto ed = fd_(q, eta, tau);
     id_.evaluate(q, eta, ed, out.id);
+    finish(q, ed, out);
+  }
+  /// …with external wrenches in the model's scalar.
+  template <class Q, class E, class TAU, class Kin>
+    requires detail::in_scalar<S, Q, E, TAU>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
+                const external_wrenches_fn<Kin, S>& w, nh_fd_derivatives_result<S, C::m_at_compile_time>& out) const {
+    const auto ed = fd_(q, eta, tau, w);
+    id_.evaluate(q, eta, ed, w, out.id);
     finish(q, ed, out);
   }
 

@@ -338,9 +338,7 @@ class rne_derivatives_fn {
   template <class Q, class QD, class QDD, class Kin, class W>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
                   const external_wrenches_fn<Kin, W>& w) const {
-    if (w.dof() != n_)
-      throw input_error("rne_derivatives: the external wrenches are for a model of " + std::to_string(w.dof()) +
-                        " joints, this one has " + std::to_string(n_));
+    check_wrenches(w);
     return run(q, qd, qdd, &w.wrenches());
   }
 
@@ -350,16 +348,33 @@ class rne_derivatives_fn {
   template <class Q, class QD, class QDD>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
                 rne_derivatives_result<S>& out) const {
+    evaluate_with(q, qd, qdd, detail::wrench_forces<S, double>{}, out);
+  }
+  /// …with external wrenches in the model's scalar.
+  template <class Q, class QD, class QDD, class Kin>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
+                const external_wrenches_fn<Kin, S>& w, rne_derivatives_result<S>& out) const {
+    check_wrenches(w);
+    evaluate_with(q, qd, qdd, detail::wrench_forces<S, S>{&w.wrenches(), &links_}, out);
+  }
+
+ private:
+  template <class Kin, class W>
+  void check_wrenches(const external_wrenches_fn<Kin, W>& w) const {
+    if (w.dof() != n_)
+      throw input_error("rne_derivatives: the external wrenches are for a model of " + std::to_string(w.dof()) +
+                        " joints, this one has " + std::to_string(n_));
+  }
+  template <class Q, class QD, class QDD, class FX>
+  void evaluate_with(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
+                     const FX& fx, rne_derivatives_result<S>& out) const {
     check(q, qd, qdd);
-    detail::wrench_forces<S, double> fx;
     const bool finite =
         opt_.velocity
             ? detail::rne_derivatives_dispatch<S>(links_, g_, opt_.gravity, q, qd, qdd, fx, out)
             : detail::rne_derivatives_dispatch<S>(links_, g_, opt_.gravity, q, vecN<S, dynamic>::Zero(n_), qdd, fx, out);
     check_result(out, finite);
   }
-
- private:
   /// `finite`: the kernel's sum of the matrices' entries was finite, so each is.
   template <class T>
   static void check_result(const rne_derivatives_result<T>& out, bool finite) {
