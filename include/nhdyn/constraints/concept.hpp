@@ -9,8 +9,9 @@
 /// A constraint type provides `dof()` (n), `k()`, `m()` and, templated on the scalar,
 /// `A(q)` (k×n), `S(q)` (n×m), `Sdot(q, qd)` (n×m). Optionally `E(q)` (n×m), and the
 /// structured products `S_times(q, η)`, `St_times(q, v)`, `Sdot_times(q, q̇, η)` and
-/// `St_M_S(q, M)` (the reduced inertia SᵀMS of a symmetric M) that avoid forming matrices;
-/// the free functions below fall back to the dense forms.
+/// `St_M_S(q, M)` (the reduced inertia SᵀMS of a symmetric M) that avoid forming matrices,
+/// and `S_into(q, s)` (S written over a matrix that holds S at another q, only where it can
+/// be nonzero); the free functions below fall back to the dense forms.
 ///
 /// Built in: `holonomic` (S = I, k = 0), `differential_drive` (any x, y, heading triple of
 /// joints, forward axis a parameter), `rolling_wheels` (a planar base on two drive wheels
@@ -98,6 +99,16 @@ matrix<T, N, M> columns_of(int n, int m, const F& f) {
     s.col(c) = f(e);
     e(c) = T(0);
   }
+  return s;
+}
+
+/// S(q) as a matrix from a constraint's S_into: zeros, then the entries that can be nonzero.
+template <class C, class Q>
+auto S_by_S_into(const C& c, const Eigen::MatrixBase<Q>& q) {
+  using T = promote_t<typename C::scalar_type, typename Q::Scalar>;
+  using Mat = matrix<T, C::n_at_compile_time, C::m_at_compile_time>;
+  Mat s = Mat::Zero(c.dof(), c.m());
+  c.S_into(q, s);
   return s;
 }
 

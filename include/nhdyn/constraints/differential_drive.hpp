@@ -103,10 +103,7 @@ struct differential_drive {
   /// own unit column (the same layout as S_times, with one sin/cos of ψ).
   template <class Q>
   auto S(const Eigen::MatrixBase<Q>& q) const {
-    using T = promote_t<Sc, typename Q::Scalar>;
-    matrix<T, N, m_at_compile_time> s = matrix<T, N, m_at_compile_time>::Zero(n, n - 1);
-    S_into(q, s);
-    return s;
+    return detail::S_by_S_into(*this, q);
   }
   /// S(q) into s (n × m), which holds zeros or S at another q: only the entries that can be
   /// nonzero are written (no allocation, no zeroing; `has_S_into`).
