@@ -193,9 +193,13 @@ struct st_plan {
   /// loops spend more on their set-up and tails than on the copy.
   static void copy_short(const T* from, int len, T* to) {
     using V = Eigen::Matrix<T, 4, 1>;
+    if (len < 4) {  // not from the runs (four or more), but safe for any length
+      std::copy_n(from, len, to);
+      return;
+    }
     int i = 0;
     for (; i + 4 <= len; i += 4) Eigen::Map<V>(to + i) = Eigen::Map<const V>(from + i);
-    if (i < len) Eigen::Map<V>(to + len - 4) = Eigen::Map<const V>(from + len - 4);  // len ≥ 4
+    if (i < len) Eigen::Map<V>(to + len - 4) = Eigen::Map<const V>(from + len - 4);
   }
 };
 }  // namespace detail
