@@ -116,6 +116,26 @@ TEST_CASE("nh derivatives: evaluate follows S's nonzeros as they vanish and reap
     CHECK(e.J() == d(q, eta, eta_dot).J());
     CHECK(rel(e.J(), lin(q, eta, eta_dot).J) < 1e-12);
   }
+  // the same on the mobile manipulator (the arm's unit columns form runs), one function object
+  // and one result over several headings for each constraint type
+  for (const char* file : {"mobile_manipulator.json", "mobile_manipulator_wheels.json", "mobile_manipulator_bicycle.json"}) {
+    const auto rf = io::load_robot_file(source("examples/robots/") + file);
+    std::visit([&](const auto& c) {
+      const int n = c.dof(), m = c.m();
+      const auto dm = inverse_dynamics_derivatives(rf.model, c);
+      const inverse_dynamics_linearizer lm(rf.model, c);
+      VectorXd qm = random_vec(rng, n, 1.5);
+      const VectorXd em = random_vec(rng, m, 1), edm = random_vec(rng, m, 1);
+      nh_derivatives_result<double, Eigen::Dynamic> r;
+      for (const double h : {0.0, 0.7, 0.0, -1.1}) {
+        qm(c.heading) = h;
+        dm.evaluate(qm, em, edm, r);
+        INFO(file << ", heading " << h);
+        CHECK(r.J() == dm(qm, em, edm).J());
+        CHECK(rel(r.J(), lm(qm, em, edm).J) < 1e-12);
+      }
+    }, *rf.constraint);
+  }
   // a result passed to another constraint of the same sizes (another layout of the base): its
   // S is not read through the first one's
   const differential_drive<double, dynamic> other(5, 1, 3, 2, 0.0, 1.0);

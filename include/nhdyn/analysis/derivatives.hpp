@@ -16,17 +16,18 @@
 ///   dual numbers through the constraint's functions alone (O(n) each, no dynamics), and
 ///   ∂q̈/∂η = Ṡ(q, q̇) + Σ_{j∈D} ∂(Sη)/∂q_j S_j,: with Ṡ the derivative of S(q + ε q̇_D) (one
 ///   dual lane: Ṡ = Σ_j ∂S/∂q_j q̇_j, the time derivative the constraint concept defines), so
-///   every constraint type works as it is. τ's derivatives are formed in m rows from the
-///   start (Sᵀ∂v/∂q̇, SᵀM, then the products with S), every product with S or Sᵀ planned from
-///   S's nonzeros at the call: the arm's identity columns as block copies, a base's few
-///   columns as short sums (O(n²) for the whole Jacobian, about the cost of copying it).
+///   every constraint type works as it is (τ too is formed with this Ṡ: for a user constraint
+///   whose own Ṡ disagrees with S's derivative, τ follows S). τ's derivatives are formed in
+///   m rows from the start (Sᵀ∂v/∂q̇, SᵀM, then the products with S), every product with S or
+///   Sᵀ planned from S's nonzeros at the call: the arm's identity columns as block copies, a
+///   base's few columns as short sums (O(n²) for the whole Jacobian, about a copy's cost).
 /// - `forward_dynamics_derivatives(t)(q, q̇, τ)`: q̈ and ∂q̈/∂q = −M⁻¹ ∂τ/∂q, ∂q̈/∂q̇ =
 ///   −M⁻¹ ∂τ/∂q̇, ∂q̈/∂τ = M⁻¹ (the implicit-function route: ∂τ/∂· at (q, q̇, FD(q, q̇, τ))).
 /// - `forward_dynamics_derivatives(t, c)(q, η, τ)`: η̇ and the state-space A = ∂f/∂x, B = ∂f/∂τ
 ///   of ẋ = f(x, τ), x = (q, η), f = (S(q)η, η̇): with K = ∂τ/∂η̇, ∂η̇/∂(q, η) = −K⁻¹∂τ/∂(q, η),
 ///   ∂η̇/∂τ = K⁻¹.
 ///
-/// All take external wrenches as a last argument (`external_wrenches(t, {…})`). The dual-number
+/// All take external wrenches after the state (`external_wrenches(t, {…})`). The dual-number
 /// linearizers of analysis/linearize.hpp compute the same matrices another way (the tests'
 /// reference).
 #include <Eigen/LU>
@@ -47,10 +48,16 @@
 namespace nhdyn {
 
 namespace detail {
-/// A number no other function object constructed in this process has (copies keep theirs).
-inline std::uint64_t next_object_id() {
+/// A tag no other function object constructed in this process has (copies keep theirs): a
+/// number and the address of its counter (a library loaded twice has two counters).
+struct object_tag {
+  const void* counter = nullptr;
+  std::uint64_t id = 0;
+  bool operator==(const object_tag&) const = default;
+};
+inline object_tag next_object_tag() {
   static std::atomic<std::uint64_t> last{0};
-  return ++last;
+  return {&last, ++last};
 }
 
 /// Every argument's scalar is S (the evaluate overloads: a reused result is in the model's
@@ -76,7 +83,7 @@ struct st_plan {
     int c, r, len;
   };
   std::vector<s_nonzero<T>> nz, nz_dot;  ///< S's and Ṡ's nonzeros, in column order
-  std::vector<int> first, first_dot;     ///< column c's: nz[first[c] … first[c + 1]), and Ṡ's
+  std::vector<int> first;                ///< column c's: nz[first[c] … first[c + 1])
   std::vector<run> runs;                 ///< unit columns, in runs of four or more
   std::vector<s_nonzero<T>> singles;     ///< the other columns of one nonzero
   std::vector<int> general;              ///< the columns of none or several
@@ -85,7 +92,8 @@ struct st_plan {
   /// Reads S and Ṡ off Se = S(q + ε q̇) (dual<T, 1> entries: values S, derivatives Ṡ). The
   /// last call's nonzero positions are kept while no nonzero lies outside them — counted over
   /// the whole matrix: the nonzeros at the kept positions equal all of its nonzeros (an entry
-  /// zero at a kept position only adds a zero term) — else Se is scanned again.
+  /// zero at a kept position only adds a zero term, which a finite product leaves unchanged;
+  /// rne's results are checked finite) — else Se is scanned again.
   template <class SE>
   void read(const SE& Se_in) {
     const auto& Se = Se_in.eval();  // a constraint's S may be an expression (holonomic: I)
@@ -110,7 +118,6 @@ struct st_plan {
           if (nonzero(e.derivative(0))) nz_dot.push_back({r, c, T(e.derivative(0))});
         }
       starts(nz, m, first);
-      starts(nz_dot, m, first_dot);
     }
     plan(m);
   }
@@ -163,8 +170,9 @@ struct st_plan {
     runs.clear(), singles.clear(), general.clear();
     const auto count = [&](int c) { return first[std::size_t(c) + 1] - first[std::size_t(c)]; };
     const auto unit_row = [&](int c) {  // r when S's column c is e_r, else −1
+      if (count(c) != 1) return -1;
       const auto& e = nz[std::size_t(first[std::size_t(c)])];
-      return count(c) == 1 && is_exact_zero(T(e.s - T(1))) ? e.r : -1;
+      return is_exact_zero(T(e.s - T(1))) ? e.r : -1;
     };
     for (int c = 0; c < m;) {
       const int r0 = unit_row(c);
@@ -228,7 +236,7 @@ struct nh_derivatives_result {
   struct scratch {
     detail::st_plan<T> st;
     Eigen::Matrix<dual<T, 1>, Eigen::Dynamic, Eigen::Dynamic> se;
-    std::uint64_t se_owner = 0;  ///< the function object (its constraint) that wrote se
+    detail::object_tag se_owner;  ///< the function object (or a copy) whose constraint wrote se
     Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> jd;
     Eigen::Matrix<T, M, Eigen::Dynamic> w, z, stx;
   } work;
@@ -315,7 +323,7 @@ class inverse_dynamics_derivatives_fn {
     for (const int j : cols_) q_eps(j).derivative(0) = qd(j);
     auto& st = w.st;
     if constexpr (has_S_into<C, vecN<D1, N>, decltype(w.se)>) {
-      // into the S(q + ε q̇) of this function object's last call (zeros at the first): the
+      // into the S(q + ε q̇) of this object's (or a copy's) last call, zeros at the first: the
       // constraint writes only the entries that can be nonzero
       if (w.se_owner != id_ || w.se.rows() != n || w.se.cols() != m) {
         w.se.setZero(n, m);
@@ -425,7 +433,7 @@ class inverse_dynamics_derivatives_fn {
 
   rne_derivatives_fn<S> d_;
   C c_;
-  std::uint64_t id_ = detail::next_object_id();  // copies share it: they hold the same constraint
+  detail::object_tag id_ = detail::next_object_tag();  // copies share it: they hold the same constraint
   std::vector<int> cols_;  // D: the joints the constraint depends on
   std::vector<int> dcol_;  // per joint, its index in cols_ (−1 if not in D)
 };
@@ -567,7 +575,7 @@ struct nh_fd_derivatives_result {
 };
 
 /// A, B of a constrained tree's forward dynamics, analytically:
-/// `forward_dynamics_derivatives(t, c)(q, eta, tau [, w])`; `evaluate(q, eta, tau, out)`
+/// `forward_dynamics_derivatives(t, c)(q, eta, tau [, w])`; `evaluate(q, eta, tau [, w], out)`
 /// reuses out's inverse-dynamics matrices and scratch (inputs and wrenches in the model's
 /// scalar).
 template <class S, class C>

@@ -54,7 +54,8 @@ concept has_input_map = requires(const C& c, const Q& q) { c.E(q); };
 template <class C, class Q, class E>
 concept has_S_times = requires(const C& c, const Q& q, const E& eta) { c.S_times(q, eta); };
 /// Optional: S(q) written into a matrix s (n × m) that holds zeros or S at another q of the
-/// same constraint, only at the entries that can be nonzero (no allocation, no zeroing).
+/// same constraint (no allocation, no zeroing): every call writes the same set of entries,
+/// whatever q, and that set covers every entry that is nonzero at any q.
 template <class C, class Q, class Mat>
 concept has_S_into = requires(const C& c, const Q& q, Mat& s) { c.S_into(q, s); };
 /// Optional: Sᵀ v without forming S.
