@@ -3,7 +3,10 @@
 /// The formulation the paper argues against, as a reasonable implementation: the projected
 /// Euler–Lagrange equations
 ///
-///     τ = Sᵀ ( M(q) (S η̇ + Ṡ η) + C(q, q̇) S η + g(q) ),   q̇ = S η
+///     τ = P Sᵀ ( M(q) (S η̇ + Ṡ η) + C(q, q̇) S η + g(q) ),   q̇ = S η
+///
+/// (P = (SᵀE)⁻¹, I for the built-in types but wheeled_base, whose actuation gives the
+/// least-norm τ of its p actuators)
 ///
 /// with every term built explicitly (run-time sized, double):
 ///   M = Σ_i m_i J_viᵀ J_vi + J_ωiᵀ R_i I_i R_iᵀ J_ωi      (J_vi: geometric Jacobian of the
@@ -234,7 +237,9 @@ class projected_lagrange {
     const Eigen::MatrixXd Sd = c_.Sdot(q, qd);
     const auto t = terms_(q, qd);
     const Eigen::VectorXd qdd = S * eta_dot + Sd * eta;
-    return S.transpose() * (t.M * qdd + t.C * qd + t.g);
+    // τ = (SᵀE)⁺ Sᵀ v: Sᵀ v itself where SᵀE = I (the built-in types but wheeled_base), the
+    // constraint's actuation otherwise (wheeled_base: the least-norm τ of p actuators)
+    return nhdyn::detail::solve_StE(c_, q, Eigen::VectorXd(S.transpose() * (t.M * qdd + t.C * qd + t.g)));
   }
 
  private:

@@ -13,7 +13,10 @@
 ///                                               mass matrix by the kernel and the reference
 ///   nh_id/<robot>/{rne, lagrange}               a robot file's nonholonomic inverse dynamics
 ///   nh_pair/<robot>/run_time                     (robot: mobile_manipulator_{ddrive, wheels,
-///   nh_fd/<robot>/nhdyn                          bicycle}) vs projected E–L on the tree, paired
+///   nh_fd/<robot>/nhdyn                          bicycle, castors}, mecanum_arm, omni3_arm,
+///                                                castor_drive_arm, powered_castors_arm; the
+///                                                wheels robot as a wheeled_base too) vs
+///                                                projected E–L on the tree, paired
 ///                                               with the holonomic rne, and its forward dynamics
 /// Every case checks its answer once, untimed, against an independent computation (KDL, the
 /// Lagrangian, the run-time-sized variant) and aborts on disagreement; every case reports
@@ -638,13 +641,13 @@ void register_batch(const std::string& model, const nhdyn::tree<double>& t) {
 /// holonomic rne at the lifted state, and the constrained forward dynamics.
 template <class C>
 void register_wheeled(const std::string& model, const nhdyn::tree<double>& t, const C& c) {
-  const int n = c.dof(), m = c.m();
+  const int n = c.dof(), m = c.m(), p = nhdyn::actuator_count(c);
   const state s = random_state(n);
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> U(-1.0, 1.0);
   const Eigen::VectorXd q = s.q, eta = Eigen::VectorXd::NullaryExpr(m, [&] { return U(rng); }),
                         eta_dot = Eigen::VectorXd::NullaryExpr(m, [&] { return U(rng); }),
-                        tau_in = Eigen::VectorXd::NullaryExpr(m, [&] { return U(rng); });
+                        tau_in = Eigen::VectorXd::NullaryExpr(p, [&] { return U(rng); });
   auto id = nhdyn::inverse_dynamics(t, c);
   projected_lagrange<C, tree_lagrange_terms> el(t, c);
   const Eigen::VectorXd tau = id(q, eta, eta_dot);
@@ -662,7 +665,8 @@ void register_wheeled(const std::string& model, const nhdyn::tree<double>& t, co
   const auto xi = nhdyn::lift(c)(q, eta, eta_dot);
   const Eigen::VectorXd xq = xi.q, xqd = xi.qd, xqdd = xi.qdd;
   auto rn = nhdyn::rne(t);
-  agree(nhdyn::apply_St(c, q, rn(xq, xqd, xqdd)), tau, 1e-14, "nh_pair/" + model + ": Sᵀ rne(lift) vs nh");
+  agree(nhdyn::detail::solve_StE(c, q, nhdyn::apply_St(c, q, rn(xq, xqd, xqdd))), tau, 1e-13,
+        "nh_pair/" + model + ": (SᵀE)⁺Sᵀ rne(lift) vs nh");
   add_paired(
       "nh_pair/" + model + "/run_time",
       [rn, xq, xqd, xqdd]() mutable {
@@ -723,12 +727,21 @@ int main(int argc, char** argv) {
   register_tree("mobile_manipulator", nhdyn::io::load_urdf(NHDYN_SOURCE_DIR "/examples/urdf/mobile_manipulator.urdf"));
   for (const auto& [name, file] : {std::pair{"mobile_manipulator_ddrive", "mobile_manipulator.json"},
                                    std::pair{"mobile_manipulator_wheels", "mobile_manipulator_wheels.json"},
-                                   std::pair{"mobile_manipulator_bicycle", "mobile_manipulator_bicycle.json"}}) {
+                                   std::pair{"mobile_manipulator_bicycle", "mobile_manipulator_bicycle.json"},
+                                   std::pair{"mobile_manipulator_castors", "mobile_manipulator_castors.json"},
+                                   std::pair{"mecanum_arm", "mecanum_arm.json"}, std::pair{"omni3_arm", "omni3_arm.json"},
+                                   std::pair{"castor_drive_arm", "castor_drive_arm.json"},
+                                   std::pair{"powered_castors_arm", "powered_castors_arm.json"}}) {
     const auto r = nhdyn::io::load_robot_file(std::string(NHDYN_SOURCE_DIR "/examples/robots/") + file);
     std::visit([&](const auto& c) {
       register_wheeled(name, r.model, c);
       register_deriv_nh(name, r.model, c);
     }, *r.constraint);
+    if (std::string(name) == "mobile_manipulator_wheels") {  // the same two wheels as a wheeled_base: `wheels` is its fast instance
+      const nhdyn::wheeled_base<double> wb(r.model, {{nhdyn::wheel_kind::fixed, "wheel_left_joint", "", 0.1},
+                                                     {nhdyn::wheel_kind::fixed, "wheel_right_joint", "", 0.1}});
+      register_wheeled("mobile_manipulator_wheels_as_wheeled_base", r.model, wb);
+    }
   }
 #endif
   std::mt19937_64 tree_rng(41);

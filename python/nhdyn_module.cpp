@@ -46,7 +46,7 @@ struct model {
   std::optional<nhdyn::differential_drive<double>> chain_constraint;
   std::optional<nhdyn::tree<double>> tree;
   std::optional<nhdyn::base_constraint> tree_constraint;
-  std::vector<std::string> joints, eta;
+  std::vector<std::string> joints, eta, tau;
   int dof() const { return int(joints.size()); }
   int m() const { return int(eta.size()); }
   bool constrained() const { return chain_constraint || tree_constraint; }
@@ -88,6 +88,7 @@ std::shared_ptr<model> load(const std::string& spec, bool strict) {
       auto r = nhdyn::io::load_robot_file(spec, o);
       out->name = r.name;
       out->eta = r.eta_names();
+      out->tau = r.tau_names();
       out->tree = std::move(r.model);
       out->tree_constraint = r.constraint;
     } else {
@@ -95,7 +96,7 @@ std::shared_ptr<model> load(const std::string& spec, bool strict) {
       out->name = out->tree->name();
     }
     out->joints = out->tree->joint_names();
-    if (!robot) out->eta = out->joints;
+    if (!robot) out->eta = out->tau = out->joints;
     return out;
 #else
     throw nhdyn::model_error(spec + ": this nhdyn module was built without URDF support (liburdfdom-dev, libtinyxml2-dev)");
@@ -106,6 +107,7 @@ std::shared_ptr<model> load(const std::string& spec, bool strict) {
   out->name = m.chain.name();
   for (int i = 0; i < m.chain.dof(); ++i) out->joints.push_back("joint" + std::to_string(i + 1));
   out->eta = m.constraint ? m.constraint->eta_names(out->joints) : out->joints;
+  out->tau = out->eta;
   out->chain = std::move(m.chain);
   out->chain_constraint = m.constraint;
   return out;
@@ -328,33 +330,33 @@ batch_function holonomic_fd_of(const Model& mdl) {
 }
 template <class Model, class C>
 batch_function nh_id_of(const Model& mdl, const C& c) {
-  const int n = mdl.dof(), k = c.m();
+  const int n = mdl.dof(), k = c.m(), p = nhdyn::actuator_count(c);
   const auto f = nhdyn::inverse_dynamics(mdl, c);
-  return {"inverse_dynamics", {{"q", n}, {"eta", k}, {"eta_dot", k}}, {{"tau", k}}, [f, n, k](const auto& in, const auto& out) {
+  return {"inverse_dynamics", {{"q", n}, {"eta", k}, {"eta_dot", k}}, {{"tau", p}}, [f, n, k, p](const auto& in, const auto& out) {
             // the state in per-thread vectors of the library's own type: its run-time-sized
             // fast path (stack scratch, no heap) takes them; a Map argument took the generic one
             thread_local VectorXd q, eta, eta_dot;
             q = cmap(in[0], n), eta = cmap(in[1], k), eta_dot = cmap(in[2], k);
-            vmap(out[0], k) = f(q, eta, eta_dot);
+            vmap(out[0], p) = f(q, eta, eta_dot);
           }};
 }
 template <class Model, class C>
 batch_function nh_id_forces_of(const Model& mdl, const C& c) {
-  const int n = mdl.dof(), m = c.m(), k = c.k();
+  const int n = mdl.dof(), m = c.m(), k = c.k(), p = nhdyn::actuator_count(c);
   const auto f = nhdyn::inverse_dynamics_with_forces(mdl, c);
-  return {"inverse_dynamics_with_forces", {{"q", n}, {"eta", m}, {"eta_dot", m}}, {{"tau", m}, {"lambda", k}},
-          [f, n, m, k](const auto& in, const auto& out) {
+  return {"inverse_dynamics_with_forces", {{"q", n}, {"eta", m}, {"eta_dot", m}}, {{"tau", p}, {"lambda", k}},
+          [f, n, m, k, p](const auto& in, const auto& out) {
             const auto r = f(cmap(in[0], n), cmap(in[1], m), cmap(in[2], m));
-            vmap(out[0], m) = r.tau;
+            vmap(out[0], p) = r.tau;
             vmap(out[1], k) = r.lambda;
           }};
 }
 template <class Model, class C>
 batch_function nh_fd_of(const Model& mdl, const C& c) {
-  const int n = mdl.dof(), m = c.m();
+  const int n = mdl.dof(), m = c.m(), p = nhdyn::actuator_count(c);
   const auto f = nhdyn::nh_forward_dynamics(mdl, c);
-  return {"forward_dynamics", {{"q", n}, {"eta", m}, {"tau", m}}, {{"eta_dot", m}}, [f, n, m](const auto& in, const auto& out) {
-            vmap(out[0], m) = f(cmap(in[0], n), cmap(in[1], m), cmap(in[2], m));
+  return {"forward_dynamics", {{"q", n}, {"eta", m}, {"tau", p}}, {{"eta_dot", m}}, [f, n, m, p](const auto& in, const auto& out) {
+            vmap(out[0], m) = f(cmap(in[0], n), cmap(in[1], m), cmap(in[2], p));
           }};
 }
 
@@ -412,11 +414,11 @@ batch_function rne_wrenches_of(const Model& mdl, const py::list& w) {
 }
 template <class Model, class C>
 batch_function nh_id_wrenches_of(const Model& mdl, const C& c, const py::list& w) {
-  const int n = mdl.dof(), m = c.m();
+  const int n = mdl.dof(), m = c.m(), p = nhdyn::actuator_count(c);
   const auto fx = nhdyn::external_wrenches(mdl, wrenches_from(mdl, w));
   const auto f = nhdyn::lift(c) | nhdyn::rne(mdl) | fx | nhdyn::constraint_forces(c);
-  return {"inverse_dynamics", {{"q", n}, {"eta", m}, {"eta_dot", m}}, {{"tau", m}}, [f, n, m](const auto& in, const auto& out) {
-            vmap(out[0], m) = f(nhdyn::reduced_state<double>{VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)),
+  return {"inverse_dynamics", {{"q", n}, {"eta", m}, {"eta_dot", m}}, {{"tau", p}}, [f, n, m, p](const auto& in, const auto& out) {
+            vmap(out[0], p) = f(nhdyn::reduced_state<double>{VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)),
                                                              VectorXd(cmap(in[2], m))}).tau;
           }};
 }
@@ -431,11 +433,11 @@ batch_function holonomic_fd_wrenches_of(const Model& mdl, const py::list& w) {
 }
 template <class Model, class C>
 batch_function nh_fd_wrenches_of(const Model& mdl, const C& c, const py::list& w) {
-  const int n = mdl.dof(), m = c.m();
+  const int n = mdl.dof(), m = c.m(), p = nhdyn::actuator_count(c);
   const auto f = nhdyn::nh_forward_dynamics(mdl, c);
   const auto fx = nhdyn::external_wrenches(mdl, wrenches_from(mdl, w));
-  return {"forward_dynamics", {{"q", n}, {"eta", m}, {"tau", m}}, {{"eta_dot", m}}, [f, fx, n, m](const auto& in, const auto& out) {
-            vmap(out[0], m) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)), VectorXd(cmap(in[2], m)), fx);
+  return {"forward_dynamics", {{"q", n}, {"eta", m}, {"tau", p}}, {{"eta_dot", m}}, [f, fx, n, m, p](const auto& in, const auto& out) {
+            vmap(out[0], m) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)), VectorXd(cmap(in[2], p)), fx);
           }};
 }
 template <class Model>
@@ -471,10 +473,10 @@ batch_function lift_of(const Model& mdl, const C& c) {
 }
 template <class Model, class C>
 batch_function project_of(const Model& mdl, const C& c) {
-  const int n = mdl.dof(), m = c.m();
+  const int n = mdl.dof(), p = nhdyn::actuator_count(c);
   const auto f = nhdyn::project(c);
-  return {"project", {{"q", n}, {"v", n}}, {{"tau", m}}, [f, n, m](const auto& in, const auto& out) {
-            vmap(out[0], m) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], n)));
+  return {"project", {{"q", n}, {"v", n}}, {{"tau", p}}, [f, n, p](const auto& in, const auto& out) {
+            vmap(out[0], p) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], n)));
           }};
 }
 
@@ -517,20 +519,20 @@ batch_function holonomic_linearize_of(const Model& mdl) {
 }
 template <class Model, class C>
 batch_function nh_linearize_of(const Model& mdl, const C& c) {
-  const int n = mdl.dof(), m = c.m();
-  return {"linearize", {{"q", n}, {"eta", m}, {"tau", m}}, {{"A", n + m, n + m}, {"B", n + m, m}}, [mdl, c, n, m](const auto& in, const auto& out) {
-            const auto ss = nhdyn::linearize_forward_dynamics(mdl, c, cmap(in[0], n), cmap(in[1], m), cmap(in[2], m));
+  const int n = mdl.dof(), m = c.m(), p = nhdyn::actuator_count(c);
+  return {"linearize", {{"q", n}, {"eta", m}, {"tau", p}}, {{"A", n + m, n + m}, {"B", n + m, p}}, [mdl, c, n, m, p](const auto& in, const auto& out) {
+            const auto ss = nhdyn::linearize_forward_dynamics(mdl, c, cmap(in[0], n), cmap(in[1], m), cmap(in[2], p));
             Eigen::Map<rowmajor>(out[0], n + m, n + m) = ss.A;
-            Eigen::Map<rowmajor>(out[1], n + m, m) = ss.B;
+            Eigen::Map<rowmajor>(out[1], n + m, p) = ss.B;
           }};
 }
 
 template <class Model, class C>
 batch_function nh_state_derivative_of(const Model& mdl, const C& c) {
-  const int n = mdl.dof(), m = c.m();
+  const int n = mdl.dof(), m = c.m(), p = nhdyn::actuator_count(c);
   const auto f = nhdyn::nh_forward_dynamics(mdl, c);
-  return {"state_derivative", {{"q", n}, {"eta", m}, {"tau", m}}, {{"xdot", n + m}}, [f, n, m](const auto& in, const auto& out) {
-            vmap(out[0], n + m) = f.state_derivative(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)), VectorXd(cmap(in[2], m)));
+  return {"state_derivative", {{"q", n}, {"eta", m}, {"tau", p}}, {{"xdot", n + m}}, [f, n, m, p](const auto& in, const auto& out) {
+            vmap(out[0], n + m) = f.state_derivative(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)), VectorXd(cmap(in[2], p)));
           }};
 }
 template <class Model>
@@ -554,10 +556,10 @@ void store_box(const nhdyn::vecN<nhdyn::interval, nhdyn::dynamic>& r, double* lo
 }
 template <class Model, class C>
 batch_function nh_bounds_of(const Model& mdl, const C& c, int split) {
-  const int n = mdl.dof(), m = c.m();
+  const int n = mdl.dof(), m = c.m(), p = nhdyn::actuator_count(c);
   return {"torque_bounds",
           {{"q_lo", n}, {"q_hi", n}, {"eta_lo", m}, {"eta_hi", m}, {"eta_dot_lo", m}, {"eta_dot_hi", m}},
-          {{"tau_lo", m}, {"tau_hi", m}},
+          {{"tau_lo", p}, {"tau_hi", p}},
           [mdl, c, n, m, split](const auto& in, const auto& out) {
             const auto r = nhdyn::torque_bounds<nhdyn::dynamic>(mdl, c, box_of(in[0], in[1], n), box_of(in[2], in[3], m),
                                                                 box_of(in[4], in[5], m), split);
@@ -621,7 +623,7 @@ struct python_controller {
         const py::object out = f(arr(q), arr(eta), arr(r), d);
         const auto tau = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(out);
         if (!tau || tau.ndim() != 1 || tau.shape(0) != m)
-          throw nhdyn::input_error("the Python controller must return " + std::to_string(m) + " numbers (one per entry of eta)");
+          throw nhdyn::input_error("the Python controller must return " + std::to_string(m) + " numbers (one per actuator: model.tau)");
         Eigen::VectorXd t(m);
         std::copy(tau.data(), tau.data() + m, t.data());
         return t;
@@ -717,8 +719,11 @@ See docs/python.md.)";
       .def_property_readonly("dof", &model::dof, "n, the number of joint coordinates q")
       .def_property_readonly("joints", [](const model& m) { return m.joints; }, "joint names in q order")
       .def_property_readonly("eta", [](const model& m) { return m.eta; },
-                             "names of eta's entries (the actuator velocities); the joint names when unconstrained")
+                             "names of eta's entries (the independent velocities); the joint names when unconstrained")
+      .def_property_readonly("tau", [](const model& m) { return m.tau; },
+                             "names of tau's entries (the actuators: a wheeled_base's actuated joints, else eta's names)")
       .def_property_readonly("m", &model::m, "len(eta)")
+      .def_property_readonly("p", [](const model& m) { return int(m.tau.size()); }, "len(tau), the number of actuators")
       .def_property_readonly("k", [](const model& m) { return m.dof() - m.m(); }, "number of constraints")
       .def_property_readonly("constrained", &model::constrained, "whether the model has a nonholonomic constraint")
       .def_property_readonly("source", [](const model& m) { return m.source; }, "what it was loaded from")
@@ -822,12 +827,12 @@ generalized forces (rne with them is rne - Q).)");
           [](const model& m, const py::array_t<double, py::array::c_style | py::array::forcecast>& Q,
              const py::array_t<double, py::array::c_style | py::array::forcecast>& E,
              const py::array_t<double, py::array::c_style | py::array::forcecast>& ED) {
-            const int n = m.dof(), k = m.m();
+            const int n = m.dof(), k = m.m(), p = int(m.tau.size());
             if (Q.ndim() != 2 || E.ndim() != 2 || ED.ndim() != 2 || Q.shape(1) != n || E.shape(1) != k || ED.shape(1) != k ||
                 E.shape(0) != Q.shape(0) || ED.shape(0) != Q.shape(0))
               throw nhdyn::input_error("_cxx_loop_inverse_dynamics: rows of q (n), eta and eta_dot (m)");
             const py::ssize_t rows = Q.shape(0);
-            py::array_t<double> out({rows, py::ssize_t(k)});
+            py::array_t<double> out({rows, py::ssize_t(p)});
             const double *q = Q.data(), *e = E.data(), *ed = ED.data();
             double* o = out.mutable_data();
             py::gil_scoped_release release;
@@ -837,7 +842,7 @@ generalized forces (rne with them is rne - Q).)");
                   VectorXd qv(n), ev(k), edv(k);
                   for (py::ssize_t i = 0; i < rows; ++i) {
                     qv = cmap(q + i * n, n), ev = cmap(e + i * k, k), edv = cmap(ed + i * k, k);
-                    vmap(o + i * k, k) = f(qv, ev, edv);
+                    vmap(o + i * p, p) = f(qv, ev, edv);
                   }
                   return 0;
                 },
@@ -857,7 +862,7 @@ generalized forces (rne with them is rne - Q).)");
 
 The exact linearisation x_dot = A dx + B du of the forward dynamics (dual numbers, from the
 inverse dynamics by the implicit-function theorem). Constrained: x = (q, eta), u = tau,
-A (n+m) x (n+m), B (n+m) x m. Holonomic: x = (q, qd), A 2n x 2n, B 2n x n.)");
+A (n+m) x (n+m), B (n+m) x p (p = len(model.tau)). Holonomic: x = (q, qd), A 2n x 2n, B 2n x n.)");
   mod.def("state_derivative",
           [](const model& m) {
             return m.dispatch([](const auto& x, const auto& c) { return nh_state_derivative_of(x, c); },
@@ -940,7 +945,7 @@ InputError for lo > hi or NaN, NumericalError for a box too wide to bound.)");
               const auto with_python = [&](const nhdyn::run_spec& s) {
                 if (interrupted) throw nhdyn::input_error("not run: interrupted (KeyboardInterrupt)");
                 return nhdyn::simulate_scene_with(s, [&](const auto&, const auto& c, int, const auto&, const auto&, const auto&) {
-                  return python_controller{controller, c.m(), &interrupted};
+                  return python_controller{controller, nhdyn::actuator_count(c), &interrupted};
                 });
               };
               {
@@ -980,7 +985,7 @@ A failing run is reported, not raised: "success" False and "failure" the reason 
 cannot be set up — an unknown frame, a wrong initial size — says "setup: ..." and has no
 rows); a scene file that cannot be read or parsed raises InputError naming the field.
 
-controller: a Python function controller(q, eta, r, ref) -> tau (m entries) used instead of
+controller: a Python function controller(q, eta, r, ref) -> tau (p = len(model.tau) entries) used instead of
 the scene's controller, on every run (one at a time: it holds the GIL): q (n), eta (m) the
 state, r (3) the measured task point [m], ref a dict of the reference at this instant: "r",
 "rd", "rdd" (3 each) and, for a joint_spline reference, "q", "qd", "qdd" (n each). The

@@ -2,8 +2,9 @@
 /// (analysis/derivatives.hpp) against the dual-number linearizers (analysis/linearize.hpp: the
 /// same matrices by forward-mode duals through the whole pipeline) and 50-digit central
 /// differences, on paper5 as a tree, the shipped mobile manipulator with each constraint type
-/// of its robot files (differential drive, rolling wheels, bicycle), a user constraint with its
-/// own input map, a holonomic arm and random trees, with external wrenches.
+/// of its robot files (differential drive, rolling wheels, bicycle), wheeled bases (mecanum:
+/// more actuators than η; castors), a user constraint with its own input map, a holonomic arm
+/// and random trees, with external wrenches.
 #include <catch2/catch.hpp>
 
 #include <nhdyn/analysis/derivatives.hpp>
@@ -38,7 +39,7 @@ void check_nh(const tree<double>& t, const C& c, std::mt19937_64& rng, const std
   INFO(what);
   CHECK(rel(d.J(), ref.J) < 1e-12);
   CHECK(rel(d.tau, inverse_dynamics(t, c)(q, eta, eta_dot)) < 1e-13);
-  const VectorXd tau = random_vec(rng, m, 5);
+  const VectorXd tau = random_vec(rng, actuator_count(c), 5);
   const auto a = forward_dynamics_derivatives(t, c)(q, eta, tau);
   const auto b = forward_dynamics_linearizer(t, c)(q, eta, tau);
   CHECK(rel(a.ss.A, b.A) < 1e-10);
@@ -57,7 +58,7 @@ void check_nh(const tree<double>& t, const C& c, std::mt19937_64& rng, const std
     }
     ef.ss.A.setOnes(3, 3), ef.ss.B.setOnes(4, 2), ef.eta_dot.setOnes(m + 5);
   }
-  inverse_dynamics_derivatives(t, c).evaluate(VectorXd(2 * q), eta_dot, tau, e);
+  inverse_dynamics_derivatives(t, c).evaluate(VectorXd(2 * q), eta_dot, eta, e);
   forward_dynamics_derivatives(t, c).evaluate(VectorXd(2 * q), eta_dot, tau, ef);
   inverse_dynamics_derivatives(t, c).evaluate(q, eta, eta_dot, e);
   forward_dynamics_derivatives(t, c).evaluate(q, eta, tau, ef);
@@ -75,7 +76,8 @@ TEST_CASE("nh derivatives: equal the dual linearizers on paper5, the mobile mani
   const auto p5 = as_tree(presets::paper5<double>().chain);
   const differential_drive<double, dynamic> dd(5, 0, 1, 2, 0.0, -1.0);  // paper5's, sized at run time
   for (int k = 0; k < 3; ++k) check_nh(p5, dd, rng, "paper5");
-  for (const char* file : {"mobile_manipulator.json", "mobile_manipulator_wheels.json", "mobile_manipulator_bicycle.json"}) {
+  for (const char* file : {"mobile_manipulator.json", "mobile_manipulator_wheels.json", "mobile_manipulator_bicycle.json",
+                           "mecanum_arm.json", "castor_drive_arm.json", "powered_castors_arm.json"}) {
     const auto r = io::load_robot_file(source("examples/robots/") + file);
     REQUIRE(r.constraint);
     std::visit([&](const auto& c) {
@@ -118,7 +120,8 @@ TEST_CASE("nh derivatives: evaluate follows S's nonzeros as they vanish and reap
   }
   // the same on the mobile manipulator (the arm's unit columns form runs), one function object
   // and one result over several headings for each constraint type
-  for (const char* file : {"mobile_manipulator.json", "mobile_manipulator_wheels.json", "mobile_manipulator_bicycle.json"}) {
+  for (const char* file : {"mobile_manipulator.json", "mobile_manipulator_wheels.json", "mobile_manipulator_bicycle.json",
+                           "mecanum_arm.json"}) {
     const auto rf = io::load_robot_file(source("examples/robots/") + file);
     std::visit([&](const auto& c) {
       const int n = c.dof(), m = c.m();
@@ -128,7 +131,7 @@ TEST_CASE("nh derivatives: evaluate follows S's nonzeros as they vanish and reap
       const VectorXd em = random_vec(rng, m, 1), edm = random_vec(rng, m, 1);
       nh_derivatives_result<double, Eigen::Dynamic> r;
       for (const double h : {0.0, 0.7, 0.0, -1.1}) {
-        qm(c.heading) = h;
+        qm(2) = h;  // the planar base's yaw
         dm.evaluate(qm, em, edm, r);
         INFO(file << ", heading " << h);
         CHECK(r.J() == dm(qm, em, edm).J());

@@ -11,6 +11,7 @@
 #include <nhdyn/kinematics/tree.hpp>
 #include <nhdyn/nhdyn.hpp>
 #ifdef NHDYN_HAVE_URDF
+#include <nhdyn/io/robot_file.hpp>
 #include <nhdyn/io/urdf.hpp>
 #endif
 #include <numbers>
@@ -156,6 +157,45 @@ TEST_CASE("docs/api.md §2: a URDF tree: gravity torques, branch-sparse M, a mer
   CHECK(rel(tool.p, a7.p + a7.R * Eigen::Vector3d(0, 0, 0.23)) < 1e-15);
   const Eigen::VectorXd q5 = Eigen::VectorXd::LinSpaced(5, 0.1, 0.9);
   CHECK(rel(nhdyn::rne(t5)(q5, q5, q5), nhdyn::rne(nhdyn::presets::paper5_chain())(q5, q5, q5)) < 1e-13);
+}
+#endif
+
+#ifdef NHDYN_HAVE_URDF
+TEST_CASE("docs/api.md §6: any wheels: a mecanum base's least-norm wheel torques") {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> U(-1, 1);
+  const auto random = [&](int n) { return Eigen::VectorXd(Eigen::VectorXd::NullaryExpr(n, [&] { return U(rng); })); };
+  const Eigen::VectorXd q = random(12), eta = random(8), eta_dot = random(8);
+  const std::string dir = NHDYN_SOURCE_DIR;
+  // snippet (the path made absolute: the test runs in any folder)
+  nhdyn::io::urdf_options planar;
+  planar.planar_base = true;  // q = (base_x, base_y, base_yaw, the URDF's joints)
+  const nhdyn::tree<double> t = nhdyn::io::load_urdf(dir + "/examples/urdf/mecanum_arm.urdf", planar);
+  const double r = 0.0475, g = std::numbers::pi / 4;  // rollers at ±45°
+  const nhdyn::wheeled_base<double> mecanum(t, {{nhdyn::wheel_kind::swedish, "wheel_fl_joint", "", r, -g},
+                                                {nhdyn::wheel_kind::swedish, "wheel_fr_joint", "", r, g},
+                                                {nhdyn::wheel_kind::swedish, "wheel_rl_joint", "", r, g},
+                                                {nhdyn::wheel_kind::swedish, "wheel_rr_joint", "", r, -g}});
+  // k = 4, η = (base_x, base_y, base_yaw, the arm's 5): m = 8; τ = the 4 wheels and the arm: p = 9
+  const auto id = nhdyn::inverse_dynamics(t, mecanum);   // project ∘ rne ∘ lift, as for every constraint
+  const Eigen::VectorXd tau = id(q, eta, eta_dot);       // the wheels' torques of least norm
+  // end snippet
+  CHECK(mecanum.k() == 4);
+  CHECK(mecanum.m() == 8);
+  CHECK(mecanum.p() == 9);
+  CHECK(tau.size() == 9);
+  CHECK(mecanum.eta_names(t.joint_names())[1] == "base_y");
+  // SᵀE τ = Sᵀ v with v = rne at the lifted state, and τ ⟂ null(SᵀE) (the least norm)
+  const Eigen::MatrixXd S = mecanum.S(q), E = mecanum.E(q), B = S.transpose() * E;
+  const auto xi = nhdyn::lift(mecanum)(q, eta, eta_dot);
+  const Eigen::VectorXd v = nhdyn::rne(t)(xi.q, xi.qd, xi.qdd);
+  CHECK(rel(B * tau, S.transpose() * v) < 1e-12);
+  const Eigen::MatrixXd N = Eigen::FullPivLU<Eigen::MatrixXd>(B).kernel();
+  REQUIRE(N.cols() == 1);
+  CHECK(std::abs(N.col(0).dot(tau)) < 1e-12 * (1 + tau.norm()));
+  // the shipped robot file builds the same constraint
+  const auto file = nhdyn::io::load_robot_file(dir + "/examples/robots/mecanum_arm.json");
+  CHECK(rel(nhdyn::inverse_dynamics(file.model, std::get<nhdyn::wheeled_base<double>>(*file.constraint))(q, eta, eta_dot), tau) < 1e-15);
 }
 #endif
 

@@ -16,8 +16,8 @@ namespace {
 constexpr std::string_view usage = R"(nhdyn bound --model MODEL [--strict]
   Guaranteed bounds on the torques over a box of states (interval arithmetic, outward rounding).
   Reads JSON lines on stdin, writes one JSON line per input line. Each box side is [lo, hi].
-  Model with a constraint (n joints, m actuator velocities):
-    {"q": [[lo, hi]] x n, "eta": [..] x m, "eta_dot": [..] x m [, "split": k]}  ->  {"tau": [[lo, hi]] x m}
+  Model with a constraint (n joints, m independent velocities, p actuators):
+    {"q": [[lo, hi]] x n, "eta": [..] x m, "eta_dot": [..] x m [, "split": k]}  ->  {"tau": [[lo, hi]] x p}
   Model without a constraint:
     {"q": [..] x n, "qd": [..] x n, "qdd": [..] x n [, "split": k]}          ->  {"tau": [[lo, hi]] x n}
   A URDF model is a tree without a constraint (the second form); a robot file with a

@@ -15,7 +15,7 @@ constexpr std::string_view usage = R"(nhdyn fd --model MODEL [--strict]
   Model without a constraint (n joints):
     {"q": [n], "qd": [n], "tau": [n]}        ->  {"qdd": [n]}         qdd = M(q)^-1 (tau - bias(q, qd))
   Model with a constraint (m actuator velocities):
-    {"q": [n], "eta": [m], "tau": [m]}       ->  {"eta_dot": [m]}     eta_dot = M_eta^-1 (S^T E tau - h_eta)
+    {"q": [n], "eta": [m], "tau": [p]}       ->  {"eta_dot": [m]}     eta_dot = M_eta^-1 (S^T E tau - h_eta)
   A URDF model is a tree without a constraint (the first form; q in `nhdyn model` order); a
   robot file with a constraint takes the second form (eta as `nhdyn model` names it).
   Either form takes an optional "f_ext" (external wrenches, as `nhdyn id --help` describes):
@@ -30,10 +30,10 @@ int constrained(const Model& model, const C& c, const std::string& name) {
   const auto fd = nhdyn::nh_forward_dynamics(model, c);
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("qd"))
-      throw nhdyn::input_error("model '" + name + "' has a constraint: lines are {\"q\", \"eta\", \"tau\"} (eta and tau have " +
-                               std::to_string(c.m()) + " entries)");
+      throw nhdyn::input_error("model '" + name + "' has a constraint: lines are {\"q\", \"eta\", \"tau\"} (eta has " +
+                               std::to_string(c.m()) + " entries, tau " + std::to_string(nhdyn::actuator_count(c)) + ")");
     l.expect_keys(with_f_ext(l, {"q", "eta", "tau"}));
-    const Eigen::VectorXd q = l.vector("q", c.dof()), eta = l.vector("eta", c.m()), tau = l.vector("tau", c.m());
+    const Eigen::VectorXd q = l.vector("q", c.dof()), eta = l.vector("eta", c.m()), tau = l.vector("tau", nhdyn::actuator_count(c));
     const Eigen::VectorXd eta_dot = l.has("f_ext") ? Eigen::VectorXd(fd(q, eta, tau, nhdyn::external_wrenches(model, wrenches_of(l, model))))
                                                    : Eigen::VectorXd(fd(q, eta, tau));
     return ordered_json{{"eta_dot", to_json(eta_dot)}};

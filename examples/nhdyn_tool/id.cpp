@@ -15,10 +15,13 @@ constexpr std::string_view usage = R"(nhdyn id --model MODEL [--strict]
   Inverse dynamics. Reads JSON lines on stdin, writes one JSON line per input line.
   Model without a constraint (n joints):
     {"q": [n], "qd": [n], "qdd": [n]}        ->  {"tau": [n]}         tau = rne(q, qd, qdd)
-  Model with a constraint (m = n - k actuator velocities; paper5: eta = (v, omega, qd4, qd5)):
-    {"q": [n], "eta": [m], "eta_dot": [m]}   ->  {"tau": [m], "lambda": [k]}
+  Model with a constraint (m = n - k independent velocities, p actuators; paper5:
+  eta = (v, omega, qd4, qd5), p = m):
+    {"q": [n], "eta": [m], "eta_dot": [m]}   ->  {"tau": [p], "lambda": [k]}
   A URDF model is a tree without a constraint (the first form; q in `nhdyn model` order); a
-  robot file with a constraint takes the second form (eta as `nhdyn model` names it).
+  robot file with a constraint takes the second form (eta, tau and lambda as `nhdyn model`
+  names them). With more actuators than eta has entries (a wheeled_base: four mecanum wheels
+  driving three base velocities) tau is the one of least weighted norm that produces the motion.
   Either form takes an optional "f_ext": external wrenches on bodies, each
     {"body": NAME, "frame": "world" | "body", "point": [3], "force": [3], "moment": [3]}
   (the environment's force [N] and moment [N m] about the point on the body; point in the

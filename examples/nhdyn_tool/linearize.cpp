@@ -14,8 +14,9 @@ namespace {
 constexpr std::string_view usage = R"(nhdyn linearize --model MODEL [--strict]
   Exact linearisation of the forward dynamics (derivatives by dual numbers, no step size).
   Reads JSON lines on stdin, writes one JSON line per input line; A and B are row-major.
-  Model with a constraint (n joints, m actuator velocities; paper5: n = 5, m = 4):
-    {"q": [n], "eta": [m], "tau": [m]}  ->  {"A": [[n+m] x (n+m)], "B": [[m] x (n+m)]}
+  Model with a constraint (n joints, m independent velocities, p actuators; paper5: n = 5,
+  m = p = 4):
+    {"q": [n], "eta": [m], "tau": [p]}  ->  {"A": [[n+m] x (n+m)], "B": [[p] x (n+m)]}
         x = (q, eta), xdot = f(x, tau) = (S(q) eta, eta_dot),  A = df/dx, B = df/dtau
   Model without a constraint (n joints):
     {"q": [n], "qd": [n], "tau": [n]}   ->  {"A": [[2n] x 2n], "B": [[n] x 2n]}
@@ -35,11 +36,11 @@ template <class Model, class C>
 int constrained(const Model& model, const C& c, const std::string& name) {
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("qd"))
-      throw nhdyn::input_error("model '" + name + "' has a constraint: lines are {\"q\", \"eta\", \"tau\"} (eta and tau have " +
-                               std::to_string(c.m()) + " entries)");
+      throw nhdyn::input_error("model '" + name + "' has a constraint: lines are {\"q\", \"eta\", \"tau\"} (eta has " +
+                               std::to_string(c.m()) + " entries, tau " + std::to_string(nhdyn::actuator_count(c)) + ")");
     l.expect_keys({"q", "eta", "tau"});
     return reply(nhdyn::linearize_forward_dynamics(model, c, l.vector("q", c.dof()), l.vector("eta", c.m()),
-                                                   l.vector("tau", c.m())));
+                                                   l.vector("tau", nhdyn::actuator_count(c))));
   });
 }
 /// Lines of a holonomic model: (q, q̇, τ) -> (A, B).

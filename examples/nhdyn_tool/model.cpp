@@ -11,24 +11,31 @@ namespace nhdyn_tool {
 namespace {
 constexpr std::string_view usage = R"(nhdyn model --model MODEL [--strict]
   Prints one JSON object describing MODEL:
-    {"name": ..., "dof": n, "joints": [n names, q order], "eta": [m names], "k": k,
-     "gravity": [gx, gy, gz]}
-  eta names the entries of eta (the actuator velocities of a model with a constraint:
-  "v" forward speed, "omega" yaw rate (the heading joint's rate), the wheel or steering
-  joints of a wheels or bicycle constraint, the other joints); without a constraint eta is
-  the joint names and k is 0. DH models name their joints joint1...jointn; a URDF's joints
-  keep their names, movable joints only, in the documented order (docs/trees-and-urdf.md);
-  a robot file's planar base adds base_x, base_y, base_yaw in front.
+    {"name": ..., "dof": n, "joints": [n names, q order], "eta": [m names], "tau": [p names],
+     "k": k, "gravity": [gx, gy, gz]}
+  eta names the entries of eta, the independent velocities of a model with a constraint
+  ("v" forward speed, "omega" yaw rate, or joint names: the wheel or steering joints of a
+  wheels or bicycle constraint, a wheeled_base's choice, the other joints); tau names the
+  actuators, tau's entries (eta's names, except for a wheeled_base: its actuated joints).
+  Without a constraint eta and tau are the joint names and k is 0. A wheeled_base adds
+    "lambda": [k names: <spin joint>.lateral, .rolling or .roller, the rows kept],
+    "mobility": {"degree_of_mobility": dm, "degree_of_steerability": ds[, "note": ...]}
+  (Campion's degrees: the base's motions at fixed steering, the independent steering
+  directions; the note says when the base cannot move or moves only along a line).
+  DH models name their joints joint1...jointn; a URDF's joints keep their names, movable
+  joints only, in the documented order (docs/trees-and-urdf.md); a robot file's planar base
+  adds base_x, base_y, base_yaw in front.
   --strict: a URDF inertia that is not physically valid is an error instead of a warning.
 )";
 
-ordered_json describe(const std::string& name, const std::vector<std::string>& joints,
-                      const std::vector<std::string>& eta, int k, const Eigen::Vector3d& g) {
+ordered_json describe(const std::string& name, const std::vector<std::string>& joints, const std::vector<std::string>& eta,
+                      const std::vector<std::string>& tau, int k, const Eigen::Vector3d& g) {
   ordered_json j;
   j["name"] = name;
   j["dof"] = joints.size();
   j["joints"] = joints;
   j["eta"] = eta;
+  j["tau"] = tau;
   j["k"] = k;
   j["gravity"] = to_json(Eigen::VectorXd(g));
   return j;
@@ -41,12 +48,23 @@ int run(const std::vector<std::string>& args) {
   if (model->tree) {
     const auto& t = *model->tree;
     const auto joints = t.joint_names();
-    if (model->tree_constraint) {  // a robot file's constraint names η's entries
-      const auto& v = *model->tree_constraint;
-      const auto eta = std::visit([&](const auto& c) { return c.eta_names(joints); }, v);
-      out = describe(model->name(), joints, eta, std::visit([](const auto& c) { return c.k(); }, v), t.gravity());
+    if (model->tree_constraint) {  // a robot file's constraint names η's and τ's entries
+      std::visit(
+          [&](const auto& c) {
+            const auto eta = c.eta_names(joints);
+            out = describe(model->name(), joints, eta, nhdyn::tau_names_of(c, joints, eta), c.k(), t.gravity());
+            if constexpr (requires { c.mobility(); }) {
+              out["lambda"] = c.lambda_names();
+              ordered_json mob;
+              mob["degree_of_mobility"] = c.mobility();
+              mob["degree_of_steerability"] = c.steerability();
+              if (!c.mobility_note().empty()) mob["note"] = c.mobility_note();
+              out["mobility"] = mob;
+            }
+          },
+          *model->tree_constraint);
     } else {
-      out = describe(model->name(), joints, joints, 0, t.gravity());
+      out = describe(model->name(), joints, joints, joints, 0, t.gravity());
     }
   } else {
     const auto& m = *model->dh;
@@ -58,13 +76,13 @@ int run(const std::vector<std::string>& args) {
       eta = c.eta_names(joints);
       k = c.k();
     }
-    out = describe(m.chain.name(), joints, eta, k, m.chain.gravity());
+    out = describe(m.chain.name(), joints, eta, eta, k, m.chain.gravity());
   }
   std::cout << nhdyn::io::dump(out) << '\n';
   return 0;
 }
 }  // namespace
 
-command command_model() { return {"model", "describe a model: name, dof, joint and eta names, k, gravity", usage, run}; }
+command command_model() { return {"model", "describe a model: name, dof, joint, eta and tau names, k, gravity", usage, run}; }
 
 }  // namespace nhdyn_tool

@@ -119,11 +119,18 @@ std::string gnuplot_program(const std::filesystem::path& dir, const group& g, co
   const bool paper5 = columns == nhdyn::run_columns();
   const auto col = [&](const std::string& name) { return column_of(columns, name); };
   if (!paper5) {  // any robot: the same figures, from the column names
-    p << "set output '" << prefix << "-path.png'\nset title '" << g.name << ": task point seen from above'\n"
+    // a planar base: its trace on the floor too (the root link's origin, grey)
+    const bool base = col("q_base_x") > 0 && col("q_base_y") > 0;
+    p << "set output '" << prefix << "-path.png'\nset title '" << g.name << ": task point" << (base ? " and base" : "")
+      << " seen from above'\n"
       << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset size ratio -1\n"
       << "plot word(files,1) every ::1 using " << col("rd_x") << ":" << col("rd_y")
       << " with lines dt 2 lw 2 lc rgb 'black' title 'r_d', \\\n  for [i=1:n] word(files,i) every ::1 using " << col("r_x")
-      << ":" << col("r_y") << " with lines lw 1 lc i dt style(i) title word(titles,i)\nset size noratio\n";
+      << ":" << col("r_y") << " with lines lw 1 lc i dt style(i) title word(titles,i)";
+    if (base)
+      p << ", \\\n  for [i=1:n] word(files,i) every ::1 using " << col("q_base_x") << ":" << col("q_base_y")
+        << " with lines lw 2 lc rgb 'grey60' dt style(i) title (i == 1 ? 'base' : '')";
+    p << "\nset size noratio\n";
     p << "set output '" << prefix << "-error.png'\nset title '" << g.name
       << ": tracking error |r_d - r|'\nset xlabel 't [s]'\nset ylabel '|r_d - r| [m]'\nset logscale y\n"
       << "plot for [i=1:n] word(files,i) every ::1 using 1:" << col("err") << " with lines lc i dt style(i) title word(titles,i)\n"

@@ -412,3 +412,39 @@ def test_stages_compose_in_python_as_the_paper_composes_them():
         assert work == pytest.approx(v @ xqd, rel=1e-12)
     with pytest.raises(nhdyn.ModelError, match="no constraint"):
         nhdyn.lift(nhdyn.load("puma560"))
+
+
+@pytest.mark.parametrize("file,n,k,p", [("mecanum_arm.json", 12, 4, 9), ("omni3_arm.json", 11, 3, 8),
+                                        ("castor_drive_arm.json", 15, 7, 8), ("powered_castors_arm.json", 19, 8, 16)])
+def test_every_wheeled_base_from_python(file, n, k, p):
+    path = os.path.join(SOURCE, "examples", "robots", file)
+    try:
+        r = nhdyn.load(path)
+    except nhdyn.ModelError as e:
+        if "without URDF support" in str(e):
+            pytest.skip(str(e))
+        raise
+    assert (r.dof, r.k, r.m, r.p, len(r.tau)) == (n, k, n - k, p, p)
+    assert not any(t.startswith("base_") for t in r.tau)
+    rng = np.random.default_rng(31)
+    q, eta, eta_dot = rng.uniform(-1, 1, r.dof), rng.uniform(-1, 1, r.m), rng.uniform(-1, 1, r.m)
+    tau, lam = nhdyn.inverse_dynamics_with_forces(r)(q, eta, eta_dot)
+    assert tau.shape == (p,) and lam.shape == (k,)
+    assert np.array_equal(nhdyn.inverse_dynamics(r)(q, eta, eta_dot), tau) or np.allclose(
+        nhdyn.inverse_dynamics(r)(q, eta, eta_dot), tau, rtol=1e-14, atol=1e-14)
+    fd = nhdyn.forward_dynamics(r)
+    assert np.allclose(fd(q, eta, tau), eta_dot, rtol=1e-9, atol=1e-9)
+    # the tool's numbers, bit for bit
+    (ref,) = tool(["id", "--model", path], [{"q": q.tolist(), "eta": eta.tolist(), "eta_dot": eta_dot.tolist()}])
+    assert np.array_equal(tau, np.array(ref["tau"])) and np.array_equal(lam, np.array(ref["lambda"]))
+    # the linearisation's eta_dot rows (B with p columns) against central differences
+    A, B = nhdyn.linearize(r)(q, eta, tau)
+    assert A.shape == (n + r.m, n + r.m) and B.shape == (n + r.m, p)
+    h, x = 1e-6, np.concatenate([q, eta])
+    g = lambda x, u: fd(x[:n], x[n:], u)
+    An = np.column_stack([(g(x + h * e, tau) - g(x - h * e, tau)) / (2 * h) for e in np.eye(n + r.m)])
+    Bn = np.column_stack([(g(x, tau + h * e) - g(x, tau - h * e)) / (2 * h) for e in np.eye(p)])
+    assert np.allclose(A[n:], An, atol=1e-6 * (1 + abs(An).max()))
+    assert np.allclose(B[n:], Bn, atol=1e-6 * (1 + abs(Bn).max()))
+    with pytest.raises(nhdyn.InputError, match=f"'tau' has {p + 1} entries; the model needs {p}"):
+        fd(q, eta, np.zeros(p + 1))

@@ -150,24 +150,24 @@ vecN<interval, N> torque_bounds(const Model& ch, const box<N>& Q, const box<N>& 
   return detail::bounded([&] { return enclose(f, detail::stack<interval, Z>(Q, QD, QDD), split); }, "tau");
 }
 
-/// Enclosure of η̇ = M_η⁻¹(SᵀEτ − h_η) over q ∈ Q, η ∈ H, τ ∈ TAU (a chain, or a tree with
-/// run-time-sized boxes).
-template <int N, class Model, class C, int M>
+/// Enclosure of η̇ = M_η⁻¹(SᵀEτ − h_η) over q ∈ Q, η ∈ H, τ ∈ TAU (p actuators; a chain, or a
+/// tree with run-time-sized boxes).
+template <int N, class Model, class C, int M, int P>
   requires(std::is_same_v<Model, chain<typename Model::scalar_type, N>> ||
            std::is_same_v<Model, tree<typename Model::scalar_type>>)
 vecN<interval, M> eta_dot_bounds(const Model& ch, const C& c, const box<N>& Q, const box<M>& H,
-                                 const box<M>& TAU, int split = 0, rne_options o = {}) {
-  const int n = c.dof(), m = c.m();
+                                 const box<P>& TAU, int split = 0, rne_options o = {}) {
+  const int n = c.dof(), m = c.m(), p = actuator_count(c);
   detail::check_size(Q, n, "q");
   detail::check_size(H, m, "eta");
-  detail::check_size(TAU, m, "tau");
+  detail::check_size(TAU, p, "tau");
   check_box(Q, "q");
   check_box(H, "eta");
   check_box(TAU, "tau");
-  constexpr int Z = (N == dynamic || M == dynamic) ? dynamic : N + 2 * M;
+  constexpr int Z = (N == dynamic || M == dynamic || P == dynamic) ? dynamic : N + M + P;
   const auto fd = nh_forward_dynamics(ch, c, o);
   const auto f = [&](const box<Z>& z) {
-    return vecN<interval, M>(fd(z.head(n), z.segment(n, m), z.tail(m)));
+    return vecN<interval, M>(fd(z.head(n), z.segment(n, m), z.tail(p)));
   };
   return detail::bounded([&] { return enclose(f, detail::stack<interval, Z>(Q, H, TAU), split); },
                          "eta_dot");

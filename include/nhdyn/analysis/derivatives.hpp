@@ -218,14 +218,14 @@ template <class T, int M>
 struct nh_derivatives_result {
   using scalar_type = T;
   vecN<T, M> tau;
-  Eigen::Matrix<T, M, Eigen::Dynamic> dq;  ///< ∂τ/∂q (m × n)
-  Eigen::Matrix<T, M, M> deta, deta_dot;   ///< ∂τ/∂η, ∂τ/∂η̇ (m × m)
+  Eigen::Matrix<T, M, Eigen::Dynamic> dq;  ///< ∂τ/∂q (p × n; p = m but for a constraint with p actuators)
+  Eigen::Matrix<T, M, M> deta, deta_dot;   ///< ∂τ/∂η, ∂τ/∂η̇ (p × m)
   Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> dqd_dq;  ///< ∂(Sη)/∂q (n × n)
   /// rne's derivatives at the lifted state (q, Sη, Sη̇ + Ṡη): ∂v/∂q, ∂v/∂q̇, M and v.
   rne_derivatives_result<T> id;
   /// [∂τ/∂q  ∂τ/∂η  ∂τ/∂η̇], as inverse_dynamics_linearizer gives it.
   Eigen::Matrix<T, M, Eigen::Dynamic> J() const {
-    Eigen::Matrix<T, M, Eigen::Dynamic> j(tau.size(), dq.cols() + 2 * tau.size());
+    Eigen::Matrix<T, M, Eigen::Dynamic> j(tau.size(), dq.cols() + deta.cols() + deta_dot.cols());
     j << dq, deta, deta_dot;
     return j;
   }
@@ -343,9 +343,9 @@ class inverse_dynamics_derivatives_fn {
     // The constraint's pieces, by duals along q_j for the joints it depends on (j ∈ D): rows
     // [∂q̇/∂q_j; ∂q̈/∂q_j; ∂(P v)/∂q_j] with v held.
     const vecN<T, N>& v = r.tau;
-    const int nd = static_cast<int>(cols_.size());
+    const int nd = static_cast<int>(cols_.size()), p = actuator_count(c_);
     auto& Jd = w.jd;
-    Jd.resize(2 * n + m, nd);
+    Jd.resize(2 * n + p, nd);
     // Jd: column k is the derivative along q_{D_k}: one dual pass of K lanes per K joints of D
     // (K = 1, 2 or 4: a base's heading, a bicycle's heading and steering, more)
     const auto passes = [&]<int K>(std::integral_constant<int, K>) {
@@ -426,7 +426,7 @@ class inverse_dynamics_derivatives_fn {
     out.dqd_dq.setZero(n, n);
     for (int k = 0; k < nd; ++k) {
       const int j = cols_[static_cast<std::size_t>(k)];
-      out.dq.col(j) += Jd.col(k).tail(m);
+      out.dq.col(j) += Jd.col(k).tail(p);
       out.dqd_dq.col(j) = Jd.col(k).head(n);
     }
   }
@@ -569,7 +569,7 @@ fd_derivatives_fn<S> forward_dynamics_derivatives(const tree<S>& t, rne_options 
 template <class T, int M>
 struct nh_fd_derivatives_result {
   vecN<T, M> eta_dot;
-  state_space<T, Eigen::Dynamic, M> ss;  ///< A ((n+m) × (n+m)), B ((n+m) × m)
+  state_space<T, Eigen::Dynamic, M> ss;  ///< A ((n+m) × (n+m)), B ((n+m) × p)
   /// The inverse dynamics' derivatives at (q, η, η̇): ∂τ/∂(q, η, η̇) (K = ∂τ/∂η̇ among them).
   nh_derivatives_result<T, M> id;
 };
@@ -591,7 +591,7 @@ class nh_fd_derivatives_fn {
     auto J = id_(q, eta, ed);
     nh_fd_derivatives_result<typename decltype(J)::scalar_type, C::m_at_compile_time> out;
     out.id = std::move(J);
-    finish(q, ed, out);
+    finish(q, tau, ed, out);
     out.id.work = {};
     return out;
   }
@@ -602,7 +602,7 @@ class nh_fd_derivatives_fn {
     auto J = id_(q, eta, ed, w);
     nh_fd_derivatives_result<typename decltype(J)::scalar_type, C::m_at_compile_time> out;
     out.id = std::move(J);
-    finish(q, ed, out);
+    finish(q, tau, ed, out);
     out.id.work = {};
     return out;
   }
@@ -614,7 +614,7 @@ class nh_fd_derivatives_fn {
                 nh_fd_derivatives_result<S, C::m_at_compile_time>& out) const {
     const auto ed = fd_(q, eta, tau);
     id_.evaluate(q, eta, ed, out.id);
-    finish(q, ed, out);
+    finish(q, tau, ed, out);
   }
   /// …with external wrenches in the model's scalar.
   template <class Q, class E, class TAU, class Kin>
@@ -623,23 +623,28 @@ class nh_fd_derivatives_fn {
                 const external_wrenches_fn<Kin, S>& w, nh_fd_derivatives_result<S, C::m_at_compile_time>& out) const {
     const auto ed = fd_(q, eta, tau, w);
     id_.evaluate(q, eta, ed, w, out.id);
-    finish(q, ed, out);
+    finish(q, tau, ed, out);
   }
 
  private:
-  template <class Q, class ED, class T, int M>
-  void finish(const Q& q, const ED& ed, nh_fd_derivatives_result<T, M>& out) const {
-    const int n = id_.dof(), m = id_.m();
+  template <class Q, class TAU, class ED, class T, int M>
+  void finish(const Q& q, const TAU& tau, const ED& ed, nh_fd_derivatives_result<T, M>& out) const {
+    const int n = id_.dof(), m = id_.m(), p = actuator_count(id_.constraint());
     const auto& J = out.id;
     out.eta_dot = ed.template cast<T>();
-    const Eigen::PartialPivLU<Eigen::Matrix<T, M, M>> K(J.deta_dot);
     out.ss.A.setZero(n + m, n + m);
-    out.ss.B.setZero(n + m, m);
+    out.ss.B.setZero(n + m, p);
     out.ss.A.topLeftCorner(n, n) = J.dqd_dq;
     out.ss.A.block(0, n, n, m) = id_.constraint().S(q).template cast<T>();
-    out.ss.A.block(n, 0, m, n) = -K.solve(J.dq);
-    out.ss.A.block(n, n, m, m) = -K.solve(J.deta);
-    out.ss.B.bottomRows(m) = K.inverse();
+    if (p == m) {
+      const Eigen::PartialPivLU<Eigen::Matrix<T, M, M>> K(J.deta_dot);
+      out.ss.A.block(n, 0, m, n) = -K.solve(J.dq);
+      out.ss.A.block(n, n, m, m) = -K.solve(J.deta);
+      out.ss.B.bottomRows(m) = K.inverse();
+    } else {  // more actuators than η (linearize.hpp, detail::redundant_eta_rows)
+      detail::redundant_eta_rows(id_.constraint(), vecN<T, dynamic>(q.template cast<T>()), J.dq, J.deta, J.deta_dot, tau,
+                                 J.tau, out.ss.A, out.ss.B);
+    }
   }
 
   decltype(nh_forward_dynamics(std::declval<const tree<S>&>(), std::declval<const C&>())) fd_;

@@ -257,7 +257,7 @@ class inverse_dynamics_linearizer {
     x << q.template cast<T>(), eta.template cast<T>();
     const int nc = static_cast<int>(cols_.size());
     constexpr int K = detail::seed_chunk<X>;
-    out.J.resize(m, n + 2 * m);
+    out.J.resize(actuator_count(c_), n + 2 * m);  // p rows: τ's (m unless the constraint has p actuators)
     // A fixed-size x with two or three vanishing columns (a planar base's x and y, and its
     // heading) gets its own, narrower dual; any other count seeds K at a time.
     bool done = false;
@@ -312,6 +312,42 @@ struct state_space {
   Eigen::Matrix<T, NX, NU> B;
 };
 
+namespace detail {
+/// The η̇ rows of A and B for p ≠ m actuators (more actuators than η: the least-norm τ of the
+/// inverse dynamics). The forward dynamics solves M_η η̇ = B(q) τ − h_η with B = SᵀE (m × p),
+/// and the inverse dynamics returns τ_id = P(q)(M_η η̇ + h_η) with B P = I, so M_η = B K for
+/// K = ∂τ_id/∂η̇ and, at the forward dynamics' η̇ (where τ may differ from τ_id by a part
+/// that B maps to 0),
+///
+///     ∂η̇/∂x = M_η⁻¹ ((∂B/∂x)(τ − τ_id) − B ∂τ_id/∂x),   ∂η̇/∂τ = M_η⁻¹ B,
+///
+/// (∂B/∂q)y by duals of q ↦ Sᵀ(q)E(q)y along the joints the constraint depends on. Writes the
+/// bottom m rows of A ((n+m) × (n+m)) and B ((n+m) × p).
+template <class C, class T, class JQ, class JE, class JD, class Tau, class TauId, class AA, class BB>
+void redundant_eta_rows(const C& c, const vecN<T, dynamic>& q, const JQ& Jq, const JE& Je, const JD& Jd, const Tau& tau,
+                        const TauId& tau_id, AA& A, BB& B) {
+  using Mat = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>;
+  const int n = c.dof(), m = c.m();
+  const Mat Bq = (c.S(q).transpose() * input_map(c, q)).template cast<T>();
+  const Mat Me = Bq * Jd;
+  const Eigen::PartialPivLU<Mat> lu(Me);
+  const vecN<T, dynamic> y = (tau.template cast<T>() - tau_id.template cast<T>()).eval();
+  Mat dBy = Mat::Zero(m, n);
+  using D = dual<T, 1>;
+  for (int j = 0; j < n; ++j) {
+    if (!constraint_depends_on(c, j)) continue;
+    vecN<D, dynamic> qd = q.template cast<D>();
+    qd(j).derivative(0) = T(1);
+    const vecN<D, dynamic> e = (input_map(c, qd) * y.template cast<D>()).eval();
+    const auto col = apply_St(c, qd, e);
+    for (int i = 0; i < m; ++i) dBy(i, j) = col(i).derivative(0);
+  }
+  A.block(n, 0, m, n) = lu.solve(Mat(dBy - Bq * Jq));
+  A.block(n, n, m, m) = -lu.solve(Mat(Bq * Je));
+  B.bottomRows(m) = lu.solve(Bq);
+}
+}  // namespace detail
+
 /// x = (q, η), f = (S(q)η, η̇), u = τ for a constrained robot (paper5: 9 states, 4 inputs):
 /// A = ∂f/∂x, B = ∂f/∂u, built once for a chain and constraint (as inverse_dynamics_linearizer)
 /// and evaluated at any (q, η, τ).
@@ -328,26 +364,25 @@ template <class S, int N, class C, class Model = chain<S, N>>
 class forward_dynamics_linearizer {
  public:
   forward_dynamics_linearizer(const Model& ch, const C& c, rne_options o = {})
-      : fd_(nh_forward_dynamics(ch, c, o)), id_(ch, c, o), c_(c) {}
+      : fd_(nh_forward_dynamics(ch, c, o)), id_(ch, c, o), id_tau_(inverse_dynamics(ch, c, o)), c_(c) {}
 
   template <class Q, class E, class TAU>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                   const Eigen::MatrixBase<TAU>& tau) const {
-    constexpr int M = C::m_at_compile_time;
+    constexpr int M = C::m_at_compile_time, P = p_of<C>;
     constexpr int NX = (N == dynamic || M == dynamic) ? dynamic : N + M;
-    const int n = c_.dof(), m = c_.m();
+    const int n = c_.dof(), m = c_.m(), p = actuator_count(c_);
     if constexpr (N == dynamic) detail::check_size(q, n, "q");
     detail::check_size(eta, m, "eta");
-    detail::check_size(tau, m, "tau");
+    detail::check_size(tau, p, "tau");
     using T = typename Q::Scalar;
     const vecN<T, N> qt = q.template cast<T>();
     const vecN<T, M> et = eta.template cast<T>();
     const vecN<T, M> eta_dot = fd_(qt, et, tau.template cast<T>());
     const auto J = id_(qt, et, eta_dot);
-    const Eigen::PartialPivLU<Eigen::Matrix<T, M, M>> K(Eigen::Matrix<T, M, M>(J.deta_dot()));
-    state_space<T, NX, M> out;
+    state_space<T, NX, P> out;
     out.A.setZero(n + m, n + m);
-    out.B.setZero(n + m, m);
+    out.B.setZero(n + m, p);
     out.A.block(0, 0, n, n) = jacobian(
         [&](const auto& qz) {
           using D = typename std::decay_t<decltype(qz)>::Scalar;
@@ -355,14 +390,21 @@ class forward_dynamics_linearizer {
         },
         qt);
     out.A.block(0, n, n, m) = c_.S(qt).template cast<T>();
-    out.A.block(n, 0, m, n + m) = -K.solve(J.J.leftCols(n + m));
-    out.B.bottomRows(m) = K.inverse();
+    if (p == m) {
+      const Eigen::PartialPivLU<Eigen::Matrix<T, M, M>> K(Eigen::Matrix<T, M, M>(J.deta_dot()));
+      out.A.block(n, 0, m, n + m) = -K.solve(J.J.leftCols(n + m));
+      out.B.bottomRows(m) = K.inverse();
+    } else {
+      const vecN<T, dynamic> tau_id = id_tau_(qt, et, eta_dot);
+      detail::redundant_eta_rows(c_, vecN<T, dynamic>(qt), J.dq(), J.deta(), J.deta_dot(), tau, tau_id, out.A, out.B);
+    }
     return out;
   }
 
  private:
   nh_forward_dynamics_fn<S, N, C, Model> fd_;
   inverse_dynamics_linearizer<S, N, C, Model> id_;
+  decltype(inverse_dynamics(std::declval<const Model&>(), std::declval<const C&>())) id_tau_;
   C c_;
 };
 template <class S, int N, class C>

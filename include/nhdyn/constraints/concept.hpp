@@ -22,6 +22,8 @@
 /// One header per built-in constraint type: holonomic.hpp, differential_drive.hpp,
 /// rolling_wheels.hpp, bicycle.hpp, user_constraint.hpp; constraint.hpp includes them all.
 #include <concepts>
+#include <string>
+#include <vector>
 #include "../model/chain.hpp"
 
 namespace nhdyn {
@@ -72,11 +74,48 @@ concept has_St_M_S = requires(const C& c, const Q& q, const MM& M) { c.St_M_S(q,
 /// rolling_wheels, bicycle).
 template <class C>
 concept has_identity_StE = requires { requires C::StE_identity; };
+/// Optional: p actuators other than m (`p()`, `p_at_compile_time`; E is n × p), and τ from
+/// r = Sᵀv by the constraint itself: `solve_actuation(q, r)` returns the τ (p entries, or
+/// columns for a matrix r) that solves SᵀE τ = r — with p > m the one of least weighted norm
+/// (wheeled_base).
+template <class C, class Q, class R>
+concept has_solve_actuation = requires(const C& c, const Q& q, const R& r) { c.solve_actuation(q, r); };
+template <class C>
+concept has_actuator_count = requires(const C& c) {
+  { c.p() } -> std::convertible_to<int>;
+  { C::p_at_compile_time } -> std::convertible_to<int>;
+};
 /// Optional: which joints A, S, Ṡ, E depend on (else: all).
 template <class C>
 concept has_depends_on = requires(const C& c, int j) { c.depends_on(j); };
 
 // ---- uniform access: structured products where the constraint has them, dense otherwise.
+
+/// p, the number of actuators (τ's entries): the constraint's `p()` where it has one, else m.
+template <class C>
+int actuator_count(const C& c) {
+  if constexpr (has_actuator_count<C>)
+    return c.p();
+  else
+    return c.m();
+}
+/// Names of τ's entries: the constraint's `tau_names(joints)` where it has them (wheeled_base:
+/// the actuated joints), else η's names `eta`.
+template <class C>
+std::vector<std::string> tau_names_of(const C& c, const std::vector<std::string>& joints, const std::vector<std::string>& eta) {
+  if constexpr (requires { c.tau_names(joints); })
+    return c.tau_names(joints);
+  else
+    return eta;
+}
+/// p at compile time (`dynamic` if not known): the constraint's, else m's.
+template <class C>
+inline constexpr int p_of = [] {
+  if constexpr (has_actuator_count<C>)
+    return C::p_at_compile_time;
+  else
+    return C::m_at_compile_time;
+}();
 
 /// Whether A, S, Ṡ or E may depend on q_j: a constraint's `depends_on(j)` where it has one,
 /// else true.

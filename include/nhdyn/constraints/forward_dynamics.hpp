@@ -70,11 +70,20 @@ class nh_forward_dynamics_fn : public stage_tag {
     detail::check_size(eta, c_.m(), "eta");
     detail::check_finite(q, "q");
     detail::check_finite(eta, "eta");
-    const auto qd = apply_S(c_, q, eta);
-    return apply_St(c_, q, rne_(q, qd, apply_Sdot(c_, q, qd, eta)));
+    using T = promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>;
+    if constexpr (!has_Sdot_times<C, Q, vecN<T, N>, E> && requires(vecN<T, N>& v) { c_.lift_into(q, eta, eta, v, v); }) {
+      // (q̇, Ṡη) in one pass, the lift at η̇ = 0, where the constraint has no structured Ṡη
+      // (wheeled_base: its Ṡ would be S's dual derivative, a dense n × m matrix)
+      vecN<T, N> qd(c_.dof()), sdeta(c_.dof());
+      c_.lift_into(q, eta, vecN<T, M>::Zero(c_.m()), qd, sdeta);
+      return apply_St(c_, q, rne_(q, qd, sdeta));
+    } else {
+      const auto qd = apply_S(c_, q, eta);
+      return apply_St(c_, q, rne_(q, qd, apply_Sdot(c_, q, qd, eta)));
+    }
   }
 
-  /// η̇ = M_η⁻¹ (SᵀE τ − h_η).
+  /// η̇ = M_η⁻¹ (SᵀE τ − h_η), τ of the constraint's p actuators (m unless it says otherwise).
   template <class Q, class E, class TAU>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                   const Eigen::MatrixBase<TAU>& tau) const {
@@ -112,7 +121,7 @@ class nh_forward_dynamics_fn : public stage_tag {
     using T = promote_t<T0, typename QX::Scalar>;
     detail::check_size(q, c_.dof(), "q");
     detail::check_size(eta, c_.m(), "eta");
-    detail::check_size(tau, c_.m(), "tau");
+    detail::check_size(tau, actuator_count(c_), "tau");
     detail::check_finite(q, "q");
     detail::check_finite(eta, "eta");
     detail::check_finite(tau, "tau");

@@ -120,7 +120,10 @@ auto solve_StE(const C& c, const Eigen::MatrixBase<Q>& q, R r) {
   constexpr int M = C::m_at_compile_time;
   using P = Eigen::Matrix<T, M, R::ColsAtCompileTime>;  // vecN<T, M> for a vector r
   constexpr bool has_E = has_input_map<C, Q>;
-  if constexpr (projection_is_St<C, Q> && std::is_same_v<R, P>) {
+  if constexpr (has_solve_actuation<C, Q, R>) {
+    // the constraint's own: p actuators, the least weighted norm when p > m (wheeled_base)
+    return c.solve_actuation(q, r);
+  } else if constexpr (projection_is_St<C, Q> && std::is_same_v<R, P>) {
     return r;
   } else if constexpr (projection_is_St<C, Q>) {
     return P(r);
@@ -176,7 +179,11 @@ class project_fn : public stage_tag {
   /// …and with the lift's memo (sin/cos of the heading), where the constraint takes it.
   template <class X, int N, class Memo>
   auto operator()(with_memo<generalized_forces<X, N>, Memo>&& f) const {
-    if constexpr (requires { c_.St_times_in_place(f.q, std::move(f.v), f.memo); }) {
+    if constexpr (requires { c_.project_with(f.q, f.v, f.memo); }) {
+      // the whole projection from the lift's factors (wheeled_base: A_D's LU and A_I)
+      detail::check_size(f.v, c_.dof(), "v");
+      return c_.project_with(f.q, f.v, f.memo);
+    } else if constexpr (requires { c_.St_times_in_place(f.q, std::move(f.v), f.memo); }) {
       detail::check_size(f.v, c_.dof(), "v");
       if constexpr (C::orthonormal_S && !has_input_map<C, decltype(f.q)>)
         return c_.St_times_in_place(f.q, std::move(f.v), f.memo);  // SᵀS = I: Sᵀv is τ (no copy)

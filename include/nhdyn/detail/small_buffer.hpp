@@ -34,7 +34,9 @@ class small_buffer {
   small_buffer(const small_buffer&) = delete;
   small_buffer& operator=(const small_buffer&) = delete;
   T& operator[](int i) { return data_[i]; }
+  const T& operator[](int i) const { return data_[i]; }
   T* data() { return data_; }
+  const T* data() const { return data_; }
 
  private:
   alignas(T) std::byte inline_[sizeof(T) * Cap];
@@ -49,7 +51,9 @@ class small_buffer<T, N, Cap> {
  public:
   explicit small_buffer(int) {}
   T& operator[](int i) { return data_[static_cast<std::size_t>(i)]; }
+  const T& operator[](int i) const { return data_[static_cast<std::size_t>(i)]; }
   T* data() { return data_.data(); }
+  const T* data() const { return data_.data(); }
 
  private:
   std::array<T, static_cast<std::size_t>(N)> data_;

@@ -231,6 +231,16 @@ class tree_rne_fn : public stage_tag {
         {xi.q.template cast<promote_t<S, X>>(), (*this)(xi.q, xi.qd, xi.qdd)}, xi.memo};
     return out;
   }
+  template <class X, class Memo>
+  auto operator()(with_memo<joint_state<X, dynamic>, Memo>&& xi) const {
+    auto v = (*this)(xi.q, xi.qd, xi.qdd);
+    using T = promote_t<S, X>;
+    if constexpr (std::is_same_v<T, X>) {  // q moves on (no copy)
+      return with_memo<generalized_forces<T, dynamic>, Memo>{{std::move(xi.q), std::move(v)}, std::move(xi.memo)};
+    } else {
+      return with_memo<generalized_forces<T, dynamic>, Memo>{{xi.q.template cast<T>(), std::move(v)}, std::move(xi.memo)};
+    }
+  }
 
   const std::vector<detail::tree_link<S>>& links() const { return links_; }
 

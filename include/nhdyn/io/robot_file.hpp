@@ -22,8 +22,12 @@
 /// - `{"type": "bicycle", "steer": J, "wheelbase": L}` (planar base): rear axle at the root
 ///   link's origin, the steered front wheel (vertical joint J) L ahead; neither axle slips
 ///   sideways; η = (v, δ̇, other joint rates); k = 2.
+/// - `{"type": "wheeled_base", "wheels": [{"kind": "fixed" | "steered" | "castor" | "swedish",
+///   "spin": J, …}, …], "eta": […], "actuated": […], "weights": {…}}` (planar base): any set of
+///   wheels, each rim point at the floor not slipping (wheeled_base, docs/model-format.md).
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -55,6 +59,12 @@ struct robot_model {
     const auto joints = model.joint_names();
     if (!constraint) return joints;
     return std::visit([&](const auto& c) { return c.eta_names(joints); }, *constraint);
+  }
+  /// Names of τ's entries: the actuated joints of a wheeled_base, else η's names.
+  std::vector<std::string> tau_names() const {
+    const auto joints = model.joint_names();
+    if (!constraint) return joints;
+    return std::visit([&](const auto& c) { return tau_names_of(c, joints, c.eta_names(joints)); }, *constraint);
   }
   /// k, the number of constraint rows (0 without a constraint).
   int k() const {
@@ -111,10 +121,76 @@ inline double axis_sign(const Eigen::Vector3d& a, int e, const std::string& wher
   return a(e) > 0 ? 1.0 : -1.0;
 }
 
+/// A list of joint names (field f of c).
+inline std::vector<std::string> name_list(const json& c, const place& at, std::string_view f) {
+  const json& l = c[std::string(f)];
+  if (!l.is_array()) throw model_error(at.field(f) + "expected a list of joint names, got " + describe(l));
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < l.size(); ++i) {
+    if (!l[i].is_string())
+      throw model_error(at.field(f) + "entry " + std::to_string(i) + ": expected a joint name, got " + describe(l[i]));
+    out.push_back(l[i].get<std::string>());
+  }
+  return out;
+}
+
+/// A "wheeled_base" constraint object: its wheels, eta, actuated and weights.
+inline wheeled_base<double> read_wheeled_base(const json& c, const tree<double>& t, const place& at, const urdf_options& opt) {
+  check_keys(c, {"type", "wheels", "eta", "actuated", "weights"}, {"wheels"}, at.prefix + ", ", "the constraint");
+  const json& ws = c["wheels"];
+  if (!ws.is_array() || ws.empty()) throw model_error(at.field("wheels") + "expected a non-empty list of wheels, got " + describe(ws));
+  std::vector<wheel> wheels;
+  for (std::size_t i = 0; i < ws.size(); ++i) {
+    const place w{at.prefix + ", wheels[" + std::to_string(i) + "]"};
+    const json& o = ws[i];
+    if (!o.is_object() || !o.contains("kind") || !o["kind"].is_string())
+      throw model_error(w.prefix + ": expected an object with a \"kind\" (fixed, steered, castor, swedish), got " + describe(o));
+    const std::string kind = o["kind"].get<std::string>();
+    wheel wh;
+    if (kind == "fixed") {
+      check_keys(o, {"kind", "spin", "radius"}, {"spin", "radius"}, w.prefix + ", ", "a fixed wheel");
+      wh.kind = wheel_kind::fixed;
+    } else if (kind == "steered") {
+      check_keys(o, {"kind", "steer", "spin", "radius"}, {"steer", "spin", "radius"}, w.prefix + ", ", "a steered wheel");
+      wh.kind = wheel_kind::steered;
+      wh.steer = string_field(o["steer"], w, "steer");
+    } else if (kind == "castor") {
+      check_keys(o, {"kind", "swivel", "spin", "radius"}, {"swivel", "spin", "radius"}, w.prefix + ", ", "a castor");
+      wh.kind = wheel_kind::castor;
+      wh.steer = string_field(o["swivel"], w, "swivel");
+    } else if (kind == "swedish") {
+      check_keys(o, {"kind", "spin", "radius", "roller_angle"}, {"spin", "radius", "roller_angle"}, w.prefix + ", ",
+                 "a swedish wheel");
+      wh.kind = wheel_kind::swedish;
+      const double g = number(o["roller_angle"], w, "roller_angle");
+      if (!(std::abs(g) > 0 && std::abs(g) <= 90))
+        throw model_error(w.field("roller_angle") + "the rollers' angle to the spin axis must be within ±90° and not 0, not " +
+                          format_number(g) + "°");
+      wh.roller_angle = g * std::numbers::pi / 180;
+    } else {
+      throw model_error(w.field("kind") + "unknown wheel kind '" + kind + "' (known: fixed, steered, castor, swedish)");
+    }
+    wh.spin = string_field(o["spin"], w, "spin");
+    wh.radius = number(o["radius"], w, "radius");
+    if (!(wh.radius > 0)) throw model_error(w.field("radius") + "the wheel radius must be positive, not " + format_number(wh.radius));
+    wheels.push_back(std::move(wh));
+  }
+  wheeled_base_options o;
+  if (c.contains("eta")) o.eta = name_list(c, at, "eta");
+  if (c.contains("actuated")) o.actuated = name_list(c, at, "actuated");
+  if (c.contains("weights")) {
+    const json& w = c["weights"];
+    if (!w.is_object()) throw model_error(at.field("weights") + "expected an object {joint name: weight}, got " + describe(w));
+    for (auto it = w.begin(); it != w.end(); ++it) o.weights.emplace_back(it.key(), number(it.value(), at, "weights"));
+  }
+  o.warn = [&opt, &at](const std::string& msg) { opt.warning(at.prefix + ": " + msg); };
+  return wheeled_base<double>(t, std::move(wheels), std::move(o));
+}
+
 inline robot_constraint read_robot_constraint(const json& c, const tree<double>& t, const place& top,
                                               const urdf_options& opt) {
   const place at{top.prefix + ", constraint"};
-  const std::string known = "(known: differential_drive, wheels, bicycle)";
+  const std::string known = "(known: differential_drive, wheels, bicycle, wheeled_base)";
   if (!c.is_object() || !c.contains("type") || !c["type"].is_string())
     throw model_error(top.field("constraint") + "expected an object with a \"type\" " + known);
   const std::string type = c["type"].get<std::string>();
@@ -162,6 +238,10 @@ inline robot_constraint read_robot_constraint(const json& c, const tree<double>&
       if (!(std::abs(L.origin.y() - R.origin.y()) > 1e-9))
         throw model_error(at.prefix + ": the two wheel centres have the same lateral position (zero track)");
       return rolling_wheels<double>(n, l, rt, r, L.origin.y(), R.origin.y(), 0.5 * (L.origin.x() + R.origin.x()), sl, sr);
+    }
+    if (type == "wheeled_base") {
+      needs_planar();
+      return read_wheeled_base(c, t, at, opt);
     }
     if (type == "bicycle") {
       check_keys(c, {"type", "steer", "wheelbase"}, {"steer", "wheelbase"}, at.prefix + ", ", "the constraint");

@@ -355,6 +355,8 @@ struct interval_traits {
     return x.lower() != x.lower() ? std::numeric_limits<double>::quiet_NaN() : 0.5 * x.lower() + 0.5 * x.upper();
   }
   static bool is_exact_zero(const I& x) { return x.lower() == 0.0 && x.upper() == 0.0; }
+  /// An interval encloses a set of values (scalar/traits.hpp, `enclosure_scalar`).
+  static constexpr bool is_enclosure = true;
   /// Both bounds finite (an empty or unbounded enclosure is not).
   static bool is_finite(const I& x) {
     return std::isfinite(x.lower()) && std::isfinite(x.upper()) && x.lower() <= x.upper();

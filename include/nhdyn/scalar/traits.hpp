@@ -76,6 +76,12 @@ concept scalar = std::copyable<S> && std::constructible_from<S, double> && !std:
                    { is_finite_scalar(a) } -> std::convertible_to<bool>;
                  };
 
+/// A scalar that encloses a set of values (an interval: scalar_traits<S>::is_enclosure), for
+/// which an algorithm may choose a formulation that keeps the enclosure tight (e.g. a linear
+/// solve preconditioned by the inverse of its midpoint matrix, constraints/wheeled_base.hpp).
+template <class S>
+concept enclosure_scalar = requires { requires scalar_traits<S>::is_enclosure; };
+
 /// Whether kernels inline every call they make for this scalar (detail/attributes.hpp's
 /// NHDYN_FLATTEN): the built-in floating-point types and SIMD packs (scalar/simd.hpp), whose
 /// operations are a few instructions each; not duals, intervals or multiprecision numbers,

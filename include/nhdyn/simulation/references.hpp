@@ -4,7 +4,7 @@
 /// joint-space references also q_d(t), q̇_d, q̈_d. Every reference is generic over the time's
 /// scalar (duals give exact Jacobians of the closed loop).
 ///
-///     circle:       r_d = c + R (u cos(ωt + φ) + v sin(ωt + φ))                (paper5.md)
+///     circle:       r_d = c + w t + R (u cos(ωt + φ) + v sin(ωt + φ))          (paper5.md: w = 0)
 ///     line:         r_d = a + s(τ)(b − a),  τ = (t − t₀)/(t₁ − t₀) clamped to [0, 1],
 ///                   s = 10τ³ − 15τ⁴ + 6τ⁵ (rest to rest: ṡ = s̈ = 0 at both ends)
 ///     spline:       r_d through waypoints p_k at times t_k: the cubic spline with zero
@@ -36,11 +36,13 @@ struct task_reference {
   vecN<T, dynamic> q, qd, qdd;
 };
 
-/// r_d(t) = c + R (u cos(ω t + φ) + v sin(ω t + φ)): paper5's circle is c = (0.35, 0, 0),
-/// R = 1, u = y₀, v = z₀, ω = 2π/20, φ = 0.
+/// r_d(t) = c + w t + R (u cos(ω t + φ) + v sin(ω t + φ)): a circle whose centre moves at the
+/// constant velocity w (0 by default). paper5's circle is c = (0.35, 0, 0), R = 1, u = y₀,
+/// v = z₀, ω = 2π/20, φ = 0.
 struct circle_reference {
   Eigen::Vector3d center{0.35, 0, 0}, u{0, 1, 0}, v{0, 0, 1};
   double radius = 1, omega = 2 * 3.14159265358979323846 / 20, phase = 0;
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< w [m/s]: the centre's drift
 
   template <class T>
   task_reference<T> operator()(const T& t) const {
@@ -51,6 +53,10 @@ struct circle_reference {
     task_reference<T> ref;
     ref.r = center.cast<T>() + T(radius) * (c * U + s * V);
     ref.rd = T(radius * omega) * (c * V - s * U);
+    if (!velocity.isZero()) {  // paper5's circle keeps its arithmetic unchanged
+      ref.r += velocity.cast<T>() * t;
+      ref.rd += velocity.cast<T>();
+    }
     ref.rdd = T(-radius * omega * omega) * (c * U + s * V);
     return ref;
   }

@@ -273,14 +273,15 @@ inline run_spec parse_run(const json& j, const std::vector<std::filesystem::path
                     rb.number("gamma2", 0.2), rb.number("epsilon", 0)};
 
   const std::string rtype = o.has("reference") && o.j.at("reference").is_object()
-                                ? o.sub("reference", {"type", "center", "u", "v", "radius", "period", "phase", "from", "to",
-                                                      "start", "end", "times", "points", "q"})
+                                ? o.sub("reference", {"type", "center", "u", "v", "radius", "period", "phase", "velocity",
+                                                      "from", "to", "start", "end", "times", "points", "q"})
                                       .text("type", "circle")
                                 : "circle";
   if (rtype == "circle") {
-    const auto r = o.sub("reference", {"type", "center", "u", "v", "radius", "period", "phase"});
+    const auto r = o.sub("reference", {"type", "center", "u", "v", "radius", "period", "phase", "velocity"});
     circle_reference cr;
     if (r.has("center")) cr.center = r.vector("center", 3);
+    if (r.has("velocity")) cr.velocity = r.vector("velocity", 3);
     if (r.has("u")) cr.u = r.vector("u", 3);
     if (r.has("v")) cr.v = r.vector("v", 3);
     cr.radius = r.number("radius", cr.radius);

@@ -148,26 +148,32 @@ std::string state_text(double t, const X& x) {
 /// A run_spec's run_options.
 inline const run_options& options_of(const run_spec& s) { return s; }
 
-/// Output columns for a robot whose q and η entries have these names: t, q_<joint>…,
-/// eta_<name>…, tau_<name>…, r_x, r_y, r_z, rd_x, rd_y, rd_z, err.
-inline std::vector<std::string> run_columns(const std::vector<std::string>& joints, const std::vector<std::string>& eta) {
+/// Output columns for a robot whose q, η and τ entries have these names: t, q_<joint>…,
+/// eta_<name>…, tau_<name>…, r_x, r_y, r_z, rd_x, rd_y, rd_z, err. τ's names default to η's
+/// (a constraint with as many actuators as η has entries).
+inline std::vector<std::string> run_columns(const std::vector<std::string>& joints, const std::vector<std::string>& eta,
+                                            const std::vector<std::string>& tau) {
   std::vector<std::string> c{"t"};
   for (const auto& j : joints) c.push_back("q_" + j);
   for (const auto& e : eta) c.push_back("eta_" + e);
-  for (const auto& e : eta) c.push_back("tau_" + e);
+  for (const auto& e : tau) c.push_back("tau_" + e);
   for (const char* x : {"r_x", "r_y", "r_z", "rd_x", "rd_y", "rd_z", "err"}) c.emplace_back(x);
   return c;
+}
+inline std::vector<std::string> run_columns(const std::vector<std::string>& joints, const std::vector<std::string>& eta) {
+  return run_columns(joints, eta, eta);
 }
 
 /// One closed-loop run on any constrained plant (see the file comment), with x = (q, η):
 ///
 /// - `fd`: the plant's nh_forward_dynamics (any model, constraint c);
 /// - `task(q)`: the plant's true task point r(q) (what is measured, before noise);
-/// - `controller(q, η, r_measured, reference(t))` → τ (m entries), generic over the scalar;
+/// - `controller(q, η, r_measured, reference(t))` → τ (p entries: the constraint's
+///   actuators, m unless it says otherwise), generic over the scalar;
 /// - `reference(t)` → task_reference (r_d, ṙ_d, r̈_d).
 ///
 /// N, M: the compile-time sizes of q and η (or `dynamic`). `columns`: the output's column
-/// names (1 + n + 2m + 7 of them). The result's times cover the integration and the output. Never throws for a failing simulation: the result says why.
+/// names (1 + n + m + p + 7 of them). The result's times cover the integration and the output. Never throws for a failing simulation: the result says why.
 template <int N, int M, class C, class FD, class Task, class Controller, class Reference>
 run_result simulate_closed_loop(const std::string& name, const C& c, const FD& fd, const Task& task,
                                 const Controller& controller, const Reference& reference, const vecN<double, N>& q0,
@@ -175,7 +181,7 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
   constexpr int D = N == dynamic || M == dynamic ? dynamic : N + M;
   const auto t_start = std::chrono::steady_clock::now();
   const double cpu_start = detail::thread_cpu_seconds();
-  const int n = int(q0.size()), m = int(eta0.size());
+  const int n = int(q0.size()), m = int(eta0.size()), p = actuator_count(c);
   if (!(s.duration > 0) || !(s.output_step > 0) || !(s.sample_rate >= 0) || !(s.noise_sigma >= 0))
     throw input_error("scene '" + name + "': duration and output step must be > 0, sample rate and noise ≥ 0");
   if (s.noise_sigma > 0 && s.sample_rate == 0)
@@ -183,9 +189,9 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
   if (c.dof() != n || c.m() != m)
     throw input_error("scene '" + name + "': the initial state has " + std::to_string(n) + " + " + std::to_string(m) +
                       " entries (q, η), the robot " + std::to_string(c.dof()) + " + " + std::to_string(c.m()));
-  if (int(columns.size()) != 1 + n + 2 * m + 7)
+  if (int(columns.size()) != 1 + n + m + p + 7)
     throw input_error("scene '" + name + "': " + std::to_string(columns.size()) + " column names for " +
-                      std::to_string(1 + n + 2 * m + 7) + " columns");
+                      std::to_string(1 + n + m + p + 7) + " columns");
 
   const long n_out = std::lround(std::floor(s.duration / s.output_step * (1 + 1e-12))) + 1;
   std::vector<double> t_out(static_cast<std::size_t>(n_out));
@@ -196,7 +202,8 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
   res.columns = std::move(columns);
   res.rows.resize(n_out, Eigen::Index(res.columns.size()));
   long rows_done = 0;
-  vecN<double, M> held = vecN<double, M>::Zero(m);
+  constexpr int P = p_of<C>;
+  vecN<double, P> held = vecN<double, P>::Zero(p);
   const bool sampled = s.sample_rate > 0;
 
   const auto q_of = [&](const auto& x) {
@@ -210,13 +217,17 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
     else return vecN<T, M>(x.template tail<M>());
   };
   const auto tau_of = [&](const auto& t, const auto& x, const vec3<std::decay_t<decltype(t)>>& r_meas) {
-    return vecN<std::decay_t<decltype(t)>, M>(controller(q_of(x), eta_of(x), r_meas, reference(t)));
+    vecN<std::decay_t<decltype(t)>, P> tau = controller(q_of(x), eta_of(x), r_meas, reference(t));
+    if (tau.size() != p)
+      throw input_error("scene '" + name + "': the controller gave " + std::to_string(tau.size()) + " torques, the robot has " +
+                        std::to_string(p) + " actuators");
+    return tau;
   };
   const auto f = [&](const auto& t, const auto& x) {
     using T = std::decay_t<decltype(t)>;
     const vecN<T, N> q = q_of(x);
     const vecN<T, M> eta = eta_of(x);
-    const vecN<T, M> tau = sampled ? vecN<T, M>(held.template cast<T>()) : tau_of(t, x, vec3<T>(task(q)));
+    const vecN<T, P> tau = sampled ? vecN<T, P>(held.template cast<T>()) : tau_of(t, x, vec3<T>(task(q)));
     vecN<T, D> dx(n + m);
     dx << apply_S(c, q, eta), fd(q, eta, tau);
     return dx;
@@ -228,7 +239,7 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
     const long i = row0 + k;
     const double t = t_out[std::size_t(i)];
     const vec3<double> r = task(q_of(x)), rd = reference(t).r;
-    const vecN<double, M> tau = sampled ? held : tau_of(t, x, r);
+    const vecN<double, P> tau = sampled ? held : tau_of(t, x, r);
     auto row = res.rows.row(i);
     row << t, x.transpose(), tau.transpose(), r.transpose(), rd.transpose(), (rd - r).norm();
     res.peak_tau = std::max(res.peak_tau, tau.cwiseAbs().maxCoeff());
@@ -374,8 +385,9 @@ run_result simulate_robot(const std::string& name, const tree<double>& plant, co
   const tree_kinematics<double> plant_kin(plant);
   const auto fd = nh_forward_dynamics(plant, c);
   const auto task = [&](const auto& q) { return plant_kin.point(q, body, point); };
+  const auto joints = plant.joint_names();
   return simulate_closed_loop<dynamic, dynamic>(name, c, fd, task, controller, reference, q0, eta0, o,
-                                                run_columns(plant.joint_names(), eta_names));
+                                                run_columns(joints, eta_names, tau_names_of(c, joints, eta_names)));
 }
 
 /// The same with the robust task-space controller (controller.hpp) on `nominal` (same
