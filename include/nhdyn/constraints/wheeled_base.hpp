@@ -933,7 +933,11 @@ class wheeled_base {
     }
     // B(i, a) = S(actuator a's joint, η's wheel-path entry i)
     const bool square = pw_ == mw_;
-    detail::wheel_buffer<U, dynamic> B(mw_ * pw_), BW(square ? 0 : mw_ * pw_), G(mw_ * mw_), x(mw_);
+    detail::wheel_buffer<U, dynamic> buf(2 * mw_ * pw_ + mw_ * mw_ + mw_);  // B, BW, G, x
+    U* const B = buf.data();
+    U* const BW = B + mw_ * pw_;
+    U* const G = BW + mw_ * pw_;
+    U* const x = G + mw_ * mw_;
     detail::wheel_buffer<int, dynamic> perm(mw_);
     for (int a = 0; a < pw_; ++a) {
       const int w = actw_[std::size_t(a)].second, d = dcol_[std::size_t(w)];
@@ -946,24 +950,24 @@ class wheeled_base {
         const U iw = U(inv_weight_w_[std::size_t(a)]);
         for (int i = 0; i < mw_; ++i) BW[i + a * mw_] = B[i + a * mw_] * iw;
       }
-      for (int i = 0; i < mw_; ++i)
-        for (int j = 0; j <= i; ++j) {
-          U g(0);
-          for (int a = 0; a < pw_; ++a) g += BW[i + a * mw_] * B[j + a * mw_];
-          G[i + j * mw_] = G[j + i * mw_] = g;
-        }
+      for (int i = 0; i < mw_ * mw_; ++i) G[i] = U(0);
+      for (int a = 0; a < pw_; ++a)  // a sum of outer products: the entries' sums run side by side
+        for (int j = 0; j < mw_; ++j)
+          for (int i = j; i < mw_; ++i) G[i + j * mw_] += BW[i + a * mw_] * B[j + a * mw_];
+      for (int j = 0; j < mw_; ++j)
+        for (int i = j + 1; i < mw_; ++i) G[j + i * mw_] = G[i + j * mw_];
     }
     // B itself by LU (square), B W⁻¹ Bᵀ (symmetric positive definite) by LDLᵀ: refused below
     // a relative pivot of 1e-10 (B) or 1e-20 (BW⁻¹Bᵀ, whose condition number is B's squared)
-    if (square ? detail::lu_in_place(G.data(), mw_, perm.data()) < singular_tolerance
-               : detail::ldlt_in_place(G.data(), mw_) < singular_tolerance * singular_tolerance)
-      throw_uncontrollable(q, B.data());
+    if (square ? detail::lu_in_place(G, mw_, perm.data()) < singular_tolerance
+               : detail::ldlt_in_place(G, mw_) < singular_tolerance * singular_tolerance)
+      throw_uncontrollable(q, B);
     for (Eigen::Index c = 0; c < cols; ++c) {
       for (int i = 0; i < mw_; ++i) x[i] = U(r(Icol_[std::size_t(i)], c));
       if (square)
-        detail::lu_solve(G.data(), perm.data(), mw_, x.data());
+        detail::lu_solve(G, perm.data(), mw_, x);
       else
-        detail::ldlt_solve(G.data(), mw_, x.data());
+        detail::ldlt_solve(G, mw_, x);
       for (int a = 0; a < pw_; ++a) {
         const int row = actw_[std::size_t(a)].first;
         if (square) {
