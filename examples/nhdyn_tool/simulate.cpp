@@ -36,7 +36,8 @@ namespace {
 constexpr std::string_view usage = R"(nhdyn simulate SCENE... --out DIR [--threads N] [--no-plots]
   Runs each SCENE (a JSON file, or the name of a shipped scene: paper-circle,
   paper-factorial, paper-noise, paper = all three, mobile-manipulator-circle,
-  mobile-manipulator-monte-carlo, puma560-line, puma560-computed-torque; shipped scenes are read from
+  mobile-manipulator-monte-carlo, mecanum-sideways-circle, puma560-line,
+  puma560-computed-torque; shipped scenes are read from
   share/nhdyn/scenes beside the tool's bin/ folder, or from $NHDYN_SCENES_DIR) and writes
   into DIR (created):
     DIR/<run>.csv       t,q1..q5,eta1..eta4,tau1..tau4,r_x,r_y,r_z,rd_x,rd_y,rd_z,err at the

@@ -179,11 +179,13 @@ inline scene_setup setup_scene(const run_spec& s) {
       }
     }();
     if (radius_factor != 1) {
-      auto* w = std::get_if<rolling_wheels<double>>(&c);
-      if (!w)
+      if (auto* w = std::get_if<rolling_wheels<double>>(&c))
+        w->radius *= radius_factor;
+      else if (auto* b = std::get_if<wheeled_base<double>>(&c))
+        *b = b->with_radius_factor(radius_factor);  // every wheel's radius
+      else
         throw input_error(where + "field '" + who + ".wheel_radius_factor': robot '" + r.name +
-                          "' has no wheel radius (its constraint is not of type 'wheels')");
-      w->radius *= radius_factor;
+                          "' has no wheel radius (its constraint is not of type 'wheels' or 'wheeled_base')");
     }
     return c;
   };
