@@ -180,7 +180,7 @@ class project_fn : public stage_tag {
   template <class X, int N, class Memo>
   auto operator()(with_memo<generalized_forces<X, N>, Memo>&& f) const {
     if constexpr (requires { c_.project_with(f.q, f.v, f.memo); }) {
-      // the whole projection from the lift's factors (wheeled_base: A_D's LU and A_I)
+      // the whole projection from what the lift kept (wheeled_base: S's dependent rows)
       detail::check_size(f.v, c_.dof(), "v");
       return c_.project_with(f.q, f.v, f.memo);
     } else if constexpr (requires { c_.St_times_in_place(f.q, std::move(f.v), f.memo); }) {

@@ -1516,7 +1516,10 @@ void wheeled_base<Sc>::build(const tree<Sc>& t, const wheeled_base_options& o) {
       for (int i = 0; i < nd; ++i) is_p[std::size_t(best[std::size_t(i)])] = true;
       for (int i = 0; i < nd; ++i) CP.row(i) = Cw.row(best[std::size_t(i)]), e.P.push_back(rw[std::size_t(best[std::size_t(i)])]);
       for (int r = 0, nn = 0; r < nr; ++r)
-        if (!is_p[std::size_t(r)]) CN.row(nn++) = Cw.row(r), e.N.push_back(rw[std::size_t(r)]);
+        if (!is_p[std::size_t(r)]) {
+          if (nd > 0) CN.row(nn) = Cw.row(r);  // a row of a 0-column matrix has no storage to point at
+          ++nn, e.N.push_back(rw[std::size_t(r)]);
+        }
       const Eigen::MatrixXd Pinv = nd ? Eigen::MatrixXd(CP.inverse()) : Eigen::MatrixXd(0, 0), G = CN * Pinv;
       for (std::size_t nn = 0; nn < e.N.size(); ++nn) {  // base row: row N − Σ G row P
         detail::elim_eq<Sc> eq;
