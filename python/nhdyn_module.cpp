@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <memory>
 #include <nhdyn/analysis/bounds.hpp>
 #include <nhdyn/analysis/linearize.hpp>
@@ -47,6 +48,7 @@ struct model {
   std::optional<nhdyn::tree<double>> tree;
   std::optional<nhdyn::base_constraint> tree_constraint;
   std::vector<std::string> joints, eta, tau;
+  std::vector<std::pair<std::string, double>> locked;  ///< joints held (load's locked=), full q order
   int dof() const { return int(joints.size()); }
   int m() const { return int(eta.size()); }
   bool constrained() const { return chain_constraint || tree_constraint; }
@@ -76,23 +78,28 @@ bool is_robot_file(const std::string& spec) {
   return j.is_object() && j.contains("urdf");
 }
 
-std::shared_ptr<model> load(const std::string& spec, bool strict) {
+std::shared_ptr<model> load(const std::string& spec, bool strict, const std::map<std::string, double>& locked) {
   auto out = std::make_shared<model>();
   out->source = spec;
   const bool urdf = ends_with_urdf(spec), robot = !urdf && is_robot_file(spec);
+  const std::vector<std::pair<std::string, double>> locks(locked.begin(), locked.end());
   if (urdf || robot) {
 #if NHDYN_PY_URDF
     nhdyn::io::urdf_options o;
     o.strict = strict;
     if (robot) {
-      auto r = nhdyn::io::load_robot_file(spec, o);
+      auto r = nhdyn::io::lock_robot(nhdyn::io::load_robot_file(spec, o), locks, "locked: ");
       out->name = r.name;
       out->eta = r.eta_names();
       out->tau = r.tau_names();
+      out->locked = r.locked;
       out->tree = std::move(r.model);
       out->tree_constraint = r.constraint;
     } else {
-      out->tree = nhdyn::io::load_urdf(spec, o);
+      // a URDF is a robot without a constraint: lock_robot locks its tree and names what it held
+      auto r = nhdyn::io::lock_robot({nhdyn::io::load_urdf(spec, o), std::nullopt, ""}, locks, "locked: ");
+      out->locked = std::move(r.locked);
+      out->tree = std::move(r.model);
       out->name = out->tree->name();
     }
     out->joints = out->tree->joint_names();
@@ -103,6 +110,9 @@ std::shared_ptr<model> load(const std::string& spec, bool strict) {
 #endif
   }
   (void)strict;
+  if (!locks.empty())
+    throw nhdyn::model_error("locked: '" + spec + "' is a DH model (a preset or a JSON model): locked= takes URDF files "
+                             "and robot files");
   auto m = nhdyn::io::load<double>(spec);
   out->name = m.chain.name();
   for (int i = 0; i < m.chain.dof(); ++i) out->joints.push_back("joint" + std::to_string(i + 1));
@@ -718,6 +728,10 @@ See docs/python.md.)";
       .def_property_readonly("name", [](const model& m) { return m.name; }, "the model's name")
       .def_property_readonly("dof", &model::dof, "n, the number of joint coordinates q")
       .def_property_readonly("joints", [](const model& m) { return m.joints; }, "joint names in q order")
+      .def_property_readonly("locked", [](const model& m) {
+            py::dict d;
+            for (const auto& [name, x] : m.locked) d[py::str(name)] = x;
+            return d; }, "the joints load(locked=...) held: {joint name: position}")
       .def_property_readonly("eta", [](const model& m) { return m.eta; },
                              "names of eta's entries (the independent velocities); the joint names when unconstrained")
       .def_property_readonly("tau", [](const model& m) { return m.tau; },
@@ -738,13 +752,15 @@ See docs/python.md.)";
       .def("__repr__", [](const batch_function& f) { return "<nhdyn.Function " + f.signature() + ">"; });
 
   mod.def("presets", [] { return nhdyn::io::preset_names(); }, "The names nhdyn.load knows without a file.");
-  mod.def("load", &load, py::arg("spec"), py::arg("strict") = false,
-          R"(load(spec, strict=False) -> Model
+  mod.def("load", &load, py::arg("spec"), py::arg("strict") = false, py::arg("locked") = std::map<std::string, double>{},
+          R"(load(spec, strict=False, locked={}) -> Model
 
 spec: a preset name (nhdyn.presets()), a JSON model file, a URDF file (*.urdf) or a robot
 file (JSON with a "urdf" key: a URDF on a wheeled base with its constraint). strict: a
-non-physical URDF inertia is an error instead of a warning on stderr. Raises ModelError
-with the file, link and field at fault.)");
+non-physical URDF inertia is an error instead of a warning on stderr. locked: {joint name
+or shell glob: position [rad or m]}: those joints held there, their links merged into their
+parents (URDF and robot files; a constraint's joints cannot be locked); Model.locked lists
+them. Raises ModelError with the file, link and field at fault.)");
   mod.def("rne", [](const model& m, const std::optional<py::list>& w) {
             if (w && !w->empty()) return m.dispatch([&](const auto& x, const auto&) { return rne_wrenches_of(x, *w); }, [&](const auto& x) { return rne_wrenches_of(x, *w); });
             return m.dispatch([](const auto& x, const auto&) { return rne_of(x); }, [](const auto& x) { return rne_of(x); }); },

@@ -10,6 +10,7 @@
 #include <nhdyn/io/json.hpp>
 #include <nhdyn/kinematics/tree.hpp>
 #include <nhdyn/nhdyn.hpp>
+#include <nhdyn/model/lock.hpp>
 #ifdef NHDYN_HAVE_URDF
 #include <nhdyn/io/robot_file.hpp>
 #include <nhdyn/io/urdf.hpp>
@@ -157,6 +158,29 @@ TEST_CASE("docs/api.md §2: a URDF tree: gravity torques, branch-sparse M, a mer
   CHECK(rel(tool.p, a7.p + a7.R * Eigen::Vector3d(0, 0, 0.23)) < 1e-15);
   const Eigen::VectorXd q5 = Eigen::VectorXd::LinSpaced(5, 0.1, 0.9);
   CHECK(rel(nhdyn::rne(t5)(q5, q5, q5), nhdyn::rne(nhdyn::presets::paper5_chain())(q5, q5, q5)) < 1e-13);
+}
+#endif
+
+#ifdef NHDYN_HAVE_URDF
+TEST_CASE("docs/api.md §2: locked joints: a smaller tree, the map between the two") {
+  const nhdyn::tree<double> arm = nhdyn::io::load_urdf(std::string(NHDYN_SOURCE_DIR) + "/examples/urdf/mobile_manipulator.urdf");
+  // snippet
+  const nhdyn::tree<double> small = nhdyn::lock(arm, {{"caster_*", 0.0}, {"head_pan_joint", 0.3}});
+  // small.joint_names(): the 11 others, in their order; "caster_front_wheel_link" etc. stay named frames
+  const nhdyn::lock_map map = nhdyn::lock_map_of(arm, {{"caster_*", 0.0}, {"head_pan_joint", 0.3}});
+  // map.kept: the full q's indices of small's joints; map.expand_q(q_small): the full q
+  // end snippet
+  CHECK(small.dof() == 11);
+  CHECK(small.find_frame("caster_front_wheel_link").body == -1);  // the castors hang from the base
+  const Eigen::VectorXd qs = Eigen::VectorXd::LinSpaced(11, -0.6, 0.6);
+  const Eigen::VectorXd q = map.expand_q(qs);
+  CHECK(q(arm.body_index("head_pan_link")) == 0.3);
+  // the tool frame stands where the full tree has it
+  const nhdyn::tree_kinematics<double> kf(arm), ks(small);
+  CHECK(rel(ks.frame(qs, "tool_frame").p, kf.frame(q, "tool_frame").p) < 1e-14);
+  // gravity torques: the kept rows of the full tree's
+  const Eigen::VectorXd z = Eigen::VectorXd::Zero(11);
+  CHECK(rel(nhdyn::rne(small)(qs, z, z), map.reduce(nhdyn::rne(arm)(q, map.expand(z), map.expand(z)))) < 1e-12);
 }
 #endif
 

@@ -254,7 +254,22 @@ TEST_CASE("URDF errors name the file, the element and the problem", "[urdf][erro
              Catch::Contains("robot.urdf: ") && (Catch::Contains("not finite") || Catch::Contains("mass")));
   CHECK_THAT(error(robot(two_links + "<joint name=\"j\" type=\"continuous\"><parent link=\"x\"/><child link=\"b\"/></joint>")),
              Catch::Contains("robot.urdf: not a valid URDF"));
-  CHECK_THAT(error(robot(two_links + joint("fixed"))), Catch::Contains("no movable joint"));
+  // joints that form a cycle: named with their lines (urdfdom says only "no root link")
+  CHECK_THAT(error(robot("<link name=\"a\"/><link name=\"b\"/><link name=\"c\"/><link name=\"d\"/>\n"
+                         "<joint name=\"ab\" type=\"continuous\"><parent link=\"a\"/><child link=\"b\"/></joint>\n"
+                         "<joint name=\"bc\" type=\"continuous\"><parent link=\"b\"/><child link=\"c\"/></joint>\n"
+                         "<joint name=\"ca\" type=\"continuous\"><parent link=\"c\"/><child link=\"a\"/></joint>\n"
+                         "<joint name=\"cd\" type=\"continuous\"><parent link=\"c\"/><child link=\"d\"/></joint>")),
+             Catch::Contains("robot.urdf: the joints form a cycle (") && Catch::Contains("'ab' (line 2)") &&
+                 Catch::Contains("'bc' (line 3)") && Catch::Contains("'ca' (line 4)") && !Catch::Contains("'cd'"));
+  {  // no movable joint: a model of 0 joints whose links are frames of the root (KDL loads such files)
+    const tree<double> t0 = io::parse_urdf(robot(two_links + joint("fixed")), "robot.urdf");
+    CHECK(t0.dof() == 0);
+    CHECK(t0.find_frame("b").body == -1);
+    const Eigen::VectorXd none(0);
+    CHECK(rne(t0)(none, none, none).size() == 0);
+    CHECK(tree_kinematics<double>(t0).frame(none, "b").p.allFinite());
+  }
   CHECK_THROWS_WITH(io::load_urdf("/nonexistent/robot.urdf"), Catch::Contains("/nonexistent/robot.urdf: cannot open"));
 }
 

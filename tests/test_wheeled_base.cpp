@@ -389,7 +389,8 @@ TEST_CASE("wheeled robot files: errors name the file, the field and the joint", 
   CHECK_THAT(err(R"({"type": "wheels", "left": "wheel_left_joint", "right": "wheel_right_joint", "radius": -0.1})"),
              Contains("positive"));
   CHECK_THAT(err(R"({"type": "wheels", "left": "caster_front_swivel_joint", "right": "wheel_right_joint", "radius": 0.1})"),
-             Contains("field 'left'") && Contains("not horizontal and lateral"));
+             Contains("field 'left'") && Contains("joint 'caster_front_swivel_joint': its axis") &&
+                 Contains("not horizontal and lateral"));
   CHECK_THAT(err(R"({"type": "wheels", "left": "arm_1_joint", "right": "wheel_right_joint", "radius": 0.1})"),
              Contains("not on the root link"));
   CHECK_THAT(err(R"({"type": "wheels", "left": "torso_lift_joint", "right": "wheel_right_joint", "radius": 0.1})"),

@@ -25,3 +25,8 @@ if(TARGET test_docs_examples AND TARGET nhdyn::urdf)
   target_link_libraries(test_docs_examples PRIVATE nhdyn::urdf)
   target_compile_definitions(test_docs_examples PRIVATE NHDYN_HAVE_URDF=1)
 endif()
+# tests/test_lock.cpp compares lock() with the URDF loader's merge of fixed joints when it can
+if(TARGET test_lock AND TARGET nhdyn::urdf)
+  target_link_libraries(test_lock PRIVATE nhdyn::urdf)
+  target_compile_definitions(test_lock PRIVATE NHDYN_HAVE_URDF=1)
+endif()

@@ -13,7 +13,7 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn bound --model MODEL [--strict]
+constexpr std::string_view usage = R"(nhdyn bound --model MODEL [--strict] [--lock 'NAME=POS,...']
   Guaranteed bounds on the torques over a box of states (interval arithmetic, outward rounding).
   Reads JSON lines on stdin, writes one JSON line per input line. Each box side is [lo, hi].
   Model with a constraint (n joints, m independent velocities, p actuators):
@@ -27,6 +27,10 @@ constexpr std::string_view usage = R"(nhdyn bound --model MODEL [--strict]
   Every true torque for every state in the box lies in the printed [lo, hi]: inputs are rounded
   outward, and printing rounds lo down and hi up. An unbounded enclosure is an error line naming
   the output (e.g. "tau[1]: the interval enclosure is unbounded ...").
+  --lock 'NAME=POS,GLOB=POS,...': hold those joints (URDF joint names or shell globs: *, ?,
+    [..]) at the positions [rad or m], their links merged into their parents; the model then
+    has the other joints only (URDF files and robot files; a constraint's joints cannot be
+    locked; `nhdyn model` lists what was locked).
 )";
 
 nhdyn::box<nhdyn::dynamic> box_of(const line& l, std::string_view key, int n) {

@@ -10,7 +10,7 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn fd --model MODEL [--strict]
+constexpr std::string_view usage = R"(nhdyn fd --model MODEL [--strict] [--lock 'NAME=POS,...']
   Forward dynamics. Reads JSON lines on stdin, writes one JSON line per input line.
   Model without a constraint (n joints):
     {"q": [n], "qd": [n], "tau": [n]}        ->  {"qdd": [n]}         qdd = M(q)^-1 (tau - bias(q, qd))
@@ -22,6 +22,10 @@ constexpr std::string_view usage = R"(nhdyn fd --model MODEL [--strict]
   the motion they cause with tau.
   A singular or near-singular (reduced) mass matrix is an error line.
   --strict: a URDF inertia that is not physically valid is an error instead of a warning.
+  --lock 'NAME=POS,GLOB=POS,...': hold those joints (URDF joint names or shell globs: *, ?,
+    [..]) at the positions [rad or m], their links merged into their parents; the model then
+    has the other joints only (URDF files and robot files; a constraint's joints cannot be
+    locked; `nhdyn model` lists what was locked).
 )";
 
 /// Lines of a model with a constraint: (q, η, τ) -> η̇.

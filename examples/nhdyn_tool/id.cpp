@@ -11,7 +11,7 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn id --model MODEL [--strict]
+constexpr std::string_view usage = R"(nhdyn id --model MODEL [--strict] [--lock 'NAME=POS,...']
   Inverse dynamics. Reads JSON lines on stdin, writes one JSON line per input line.
   Model without a constraint (n joints):
     {"q": [n], "qd": [n], "qdd": [n]}        ->  {"tau": [n]}         tau = rne(q, qd, qdd)
@@ -29,6 +29,10 @@ constexpr std::string_view usage = R"(nhdyn id --model MODEL [--strict]
   bodies link1 ... linkN). tau (and lambda) are then what balances them as well.
   Keys must be exactly those of the model's form; anything else is an error line.
   --strict: a URDF inertia that is not physically valid is an error instead of a warning.
+  --lock 'NAME=POS,GLOB=POS,...': hold those joints (URDF joint names or shell globs: *, ?,
+    [..]) at the positions [rad or m], their links merged into their parents; the model then
+    has the other joints only (URDF files and robot files; a constraint's joints cannot be
+    locked; `nhdyn model` lists what was locked).
 )";
 
 /// Lines of a model with a constraint: (q, η, η̇) -> (τ, λ).

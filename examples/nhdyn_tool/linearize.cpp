@@ -11,7 +11,7 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn linearize --model MODEL [--strict]
+constexpr std::string_view usage = R"(nhdyn linearize --model MODEL [--strict] [--lock 'NAME=POS,...']
   Exact linearisation of the forward dynamics (derivatives by dual numbers, no step size).
   Reads JSON lines on stdin, writes one JSON line per input line; A and B are row-major.
   Model with a constraint (n joints, m independent velocities, p actuators; paper5: n = 5,
@@ -25,6 +25,10 @@ constexpr std::string_view usage = R"(nhdyn linearize --model MODEL [--strict]
   robot file with a constraint takes the first form (eta as `nhdyn model` names it).
   A singular (reduced) mass matrix is an error line.
   --strict: a URDF inertia that is not physically valid is an error instead of a warning.
+  --lock 'NAME=POS,GLOB=POS,...': hold those joints (URDF joint names or shell globs: *, ?,
+    [..]) at the positions [rad or m], their links merged into their parents; the model then
+    has the other joints only (URDF files and robot files; a constraint's joints cannot be
+    locked; `nhdyn model` lists what was locked).
 )";
 
 ordered_json reply(const auto& ss) {

@@ -9,7 +9,7 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn model --model MODEL [--strict]
+constexpr std::string_view usage = R"(nhdyn model --model MODEL [--strict] [--lock 'NAME=POS,...']
   Prints one JSON object describing MODEL:
     {"name": ..., "dof": n, "joints": [n names, q order], "eta": [m names], "tau": [p names],
      "k": k, "gravity": [gx, gy, gz]}
@@ -21,11 +21,16 @@ constexpr std::string_view usage = R"(nhdyn model --model MODEL [--strict]
     "lambda": [k names: <spin joint>.lateral, .rolling or .roller, the rows kept],
     "mobility": {"degree_of_mobility": dm, "degree_of_steerability": ds[, "note": ...]}
   (Campion's degrees: the base's motions at fixed steering, the independent steering
-  directions; the note says when the base cannot move or moves only along a line).
+  directions; the note says when the base cannot move or moves only along a line). A model
+  with locked joints (--lock, a robot file's "locked") adds "locked": {joint: position}.
   DH models name their joints joint1...jointn; a URDF's joints keep their names, movable
   joints only, in the documented order (docs/trees-and-urdf.md); a robot file's planar base
   adds base_x, base_y, base_yaw in front.
   --strict: a URDF inertia that is not physically valid is an error instead of a warning.
+  --lock 'NAME=POS,GLOB=POS,...': hold those joints (URDF joint names or shell globs: *, ?,
+    [..]) at the positions [rad or m], their links merged into their parents; the model then
+    has the other joints only (URDF files and robot files; a constraint's joints cannot be
+    locked; `nhdyn model` lists what was locked).
 )";
 
 ordered_json describe(const std::string& name, const std::vector<std::string>& joints, const std::vector<std::string>& eta,
@@ -65,6 +70,11 @@ int run(const std::vector<std::string>& args) {
           *model->tree_constraint);
     } else {
       out = describe(model->name(), joints, joints, joints, 0, t.gravity());
+    }
+    if (!model->locked.empty()) {  // what was held, in the full model's q order
+      ordered_json held = ordered_json::object();
+      for (const auto& [name, x] : model->locked) held[name] = x;
+      out["locked"] = held;
     }
   } else {
     const auto& m = *model->dh;

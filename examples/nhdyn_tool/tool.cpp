@@ -9,6 +9,7 @@
 #include <nhdyn/io/robot_file.hpp>
 #endif
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 
 namespace nhdyn_tool {
@@ -71,20 +72,45 @@ bool is_robot_file(const std::string& spec) {
   return j.is_object() && j.contains("urdf");
 }
 
-any_model load_any_model(const std::string& spec, bool strict) {
+std::vector<std::pair<std::string, double>> parse_locks(const std::string& text) {
+  std::vector<std::pair<std::string, double>> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string entry = text.substr(start, end - start);
+    const std::size_t eq = entry.rfind('=');
+    const std::string value = eq == std::string::npos ? "" : entry.substr(eq + 1);
+    char* stop = nullptr;
+    const double x = value.empty() ? 0.0 : std::strtod(value.c_str(), &stop);
+    if (eq == std::string::npos || eq == 0 || value.empty() || stop != value.c_str() + value.size() || !std::isfinite(x))
+      throw usage_error("--lock: '" + entry + "' is not NAME=POSITION (a joint name or glob, '=', a finite number)");
+    out.emplace_back(entry.substr(0, eq), x);
+    start = end + 1;
+  }
+  return out;
+}
+
+any_model load_any_model(const std::string& spec, bool strict, const std::vector<std::pair<std::string, double>>& locks) {
   const bool robot = !is_urdf(spec) && is_robot_file(spec);
-  if (!is_urdf(spec) && !robot) return {load_model(spec), std::nullopt, std::nullopt};
+  if (!is_urdf(spec) && !robot) {
+    if (!locks.empty())
+      throw nhdyn::model_error("--lock: '" + spec + "' is a DH model (a preset or a JSON model): --lock takes URDF files "
+                               "and robot files");
+    return {load_model(spec), std::nullopt, std::nullopt, {}};
+  }
 #ifdef NHDYN_TOOL_URDF
   nhdyn::io::urdf_options o;
   o.strict = strict;
   if (robot) {
-    auto r = nhdyn::io::load_robot_file(spec, o);
+    auto r = nhdyn::io::lock_robot(nhdyn::io::load_robot_file(spec, o), locks, "--lock: ");
     // the robot file's name (its "name", else the URDF's) names the model in output and messages
     const auto& t = r.model;
     return {std::nullopt, nhdyn::tree<double>(t.bodies(), t.gravity(), r.name, t.validation_policy(), t.root_name(), t.frames()),
-            r.constraint};
+            r.constraint, r.locked};
   }
-  return {std::nullopt, nhdyn::io::load_urdf(spec, o), std::nullopt};
+  // a URDF is a robot without a constraint: lock_robot locks its tree and names what it held
+  auto r = nhdyn::io::lock_robot({nhdyn::io::load_urdf(spec, o), std::nullopt, ""}, locks, "--lock: ");
+  return {std::nullopt, std::move(r.model), std::nullopt, std::move(r.locked)};
 #else
   (void)strict;
   throw nhdyn::model_error(spec + ": this nhdyn was built without URDF support (urdfdom, tinyxml2)");
@@ -95,10 +121,12 @@ std::optional<any_model> start_any_model_command(const std::vector<std::string>&
   CLI::App app;
   std::string model;
   bool strict = false;
+  std::string lock;
   app.add_option("--model", model)->required();
   app.add_flag("--strict", strict);
+  app.add_option("--lock", lock);
   if (!parse_command_line(app, args, usage)) return std::nullopt;
-  return load_any_model(model, strict);
+  return load_any_model(model, strict, lock.empty() ? std::vector<std::pair<std::string, double>>{} : parse_locks(lock));
 }
 
 nhdyn::io::model<double> load_model(const std::string& spec) {

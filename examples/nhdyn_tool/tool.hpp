@@ -68,6 +68,8 @@ struct any_model {
   std::optional<nhdyn::tree<double>> tree;
   /// A robot file's constraint on the tree (differential_drive, rolling_wheels or bicycle).
   std::optional<nhdyn::base_constraint> tree_constraint;
+  /// The joints held (the robot file's "locked" and --lock), by name, with their positions.
+  std::vector<std::pair<std::string, double>> locked;
   const std::string& name() const { return dh ? dh->chain.name() : tree->name(); }
 };
 /// Calls `constrained(model, c)` for a model with a constraint (a DH chain with its
@@ -86,9 +88,14 @@ int dispatch(const any_model& a, const Constrained& constrained, const Holonomic
 /// Whether MODEL names a URDF file (its extension is .urdf, any case).
 bool is_urdf(const std::string& spec);
 /// load_model, URDF files (*.urdf) and robot files (JSON with a "urdf" key); `strict`: a non-physical inertia in a URDF is an error
-/// instead of a warning on stderr.
-any_model load_any_model(const std::string& spec, bool strict = false);
-/// start_model_command for the subcommands that take any model: `--model MODEL [--strict]`.
+/// instead of a warning on stderr; `locks`: joints held at positions (names or globs,
+/// nhdyn::lock), for URDF files and robot files.
+any_model load_any_model(const std::string& spec, bool strict = false,
+                         const std::vector<std::pair<std::string, double>>& locks = {});
+/// The value of --lock, 'NAME=POSITION,GLOB=POSITION,...': usage_error naming a bad entry.
+std::vector<std::pair<std::string, double>> parse_locks(const std::string& text);
+/// start_model_command for the subcommands that take any model:
+/// `--model MODEL [--strict] [--lock 'NAME=POS,...']`.
 std::optional<any_model> start_any_model_command(const std::vector<std::string>& args, std::string_view usage);
 
 /// Where the tool's shipped data lives: `share/nhdyn` beside the folder of the running

@@ -448,3 +448,35 @@ def test_every_wheeled_base_from_python(file, n, k, p):
     assert np.allclose(B[n:], Bn, atol=1e-6 * (1 + abs(Bn).max()))
     with pytest.raises(nhdyn.InputError, match=f"'tau' has {p + 1} entries; the model needs {p}"):
         fd(q, eta, np.zeros(p + 1))
+
+
+def test_locked_joints_from_python():
+    """load(locked=...) on a robot file: the kept rows of the full robot's torques, with the
+    locked joints at their positions and at rest; the tool's --lock gives the same numbers."""
+    path = os.path.join(SOURCE, "examples", "robots", "mobile_manipulator_wheels.json")
+    try:
+        full = nhdyn.load(path)
+    except nhdyn.ModelError as e:
+        if "without URDF support" in str(e):
+            pytest.skip(str(e))
+        raise
+    r = nhdyn.load(path, locked={"head_*": 0.3, "arm_7_joint": -0.5})
+    assert r.locked == {"head_pan_joint": 0.3, "head_tilt_joint": 0.3, "arm_7_joint": -0.5}
+    assert (r.dof, r.m) == (full.dof - 3, full.m - 3)
+    assert not any(n.startswith("head_") for n in r.joints)
+    kept_q = [full.joints.index(n) for n in r.joints]
+    kept_eta = [full.eta.index(n) for n in r.eta]
+    rng = np.random.default_rng(9)
+    q, eta, eta_dot = rng.uniform(-1, 1, full.dof), rng.uniform(-1, 1, full.m), rng.uniform(-1, 1, full.m)
+    for n, x in r.locked.items():
+        q[full.joints.index(n)] = x
+        eta[full.eta.index(n)] = eta_dot[full.eta.index(n)] = 0.0
+    want = nhdyn.inverse_dynamics(full)(q, eta, eta_dot)[kept_eta]
+    got = nhdyn.inverse_dynamics(r)(q[kept_q], eta[kept_eta], eta_dot[kept_eta])
+    assert np.allclose(got, want, rtol=1e-12, atol=1e-12)
+    line = {"q": list(q[kept_q]), "eta": list(eta[kept_eta]), "eta_dot": list(eta_dot[kept_eta])}
+    assert np.array_equal(np.array(tool(["id", "--model", path, "--lock", "head_*=0.3,arm_7_joint=-0.5"], [line])[0]["tau"]), got)
+    with pytest.raises(nhdyn.ModelError, match="'wheel_left_joint' belongs to the constraint"):
+        nhdyn.load(path, locked={"wheel_left_joint": 0.0})
+    with pytest.raises(nhdyn.ModelError, match="'finger_\\*' matches no movable joint"):
+        nhdyn.load(path, locked={"finger_*": 0.0})

@@ -276,3 +276,64 @@ TEST_CASE("tool: robot files with each constraint type in model, id, fd, lineari
         *robot.constraint);
   }
 }
+
+TEST_CASE("tool: --lock holds joints of a robot file: model lists them, id equals the full robot's kept entries") {
+  const std::string file = std::string(NHDYN_SOURCE_DIR) + "/examples/robots/mobile_manipulator.json";
+  const std::string lock = "--lock 'head_*=0.3,arm_7_joint=-0.5'";
+  auto r = run_tool("model --model '" + file + "' " + lock);
+  REQUIRE(r.status == 0);
+  const json j = json::parse(r.lines[0]);
+  CHECK(j["dof"] == 16);
+  CHECK(j["eta"].size() == 15);
+  CHECK(j["locked"] == json::parse(R"({"head_pan_joint": 0.3, "head_tilt_joint": 0.3, "arm_7_joint": -0.5})"));
+  for (const auto& name : j["joints"]) CHECK(name.get<std::string>().find("head_") == std::string::npos);
+  // the full robot's τ with the locked joints at their positions, zero rate and acceleration
+  const auto full = nhdyn::io::load_robot_file(file);
+  const auto& c = std::get<nhdyn::differential_drive<double>>(*full.constraint);
+  const auto joints = full.model.joint_names();
+  const auto eta_full = c.eta_names(joints);
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(-1, 1);
+  VectorXd q = VectorXd::NullaryExpr(19, [&] { return u(rng); });
+  VectorXd eta = VectorXd::NullaryExpr(18, [&] { return u(rng); }), eta_dot = eta.reverse();
+  std::vector<int> kept_q, kept_eta;
+  for (int i = 0; i < 19; ++i) {
+    const auto& n = joints[std::size_t(i)];
+    if (n.rfind("head_", 0) == 0) q(i) = 0.3;
+    else if (n == "arm_7_joint") q(i) = -0.5;
+    else kept_q.push_back(i);
+  }
+  for (int i = 0; i < 18; ++i) {
+    const auto& n = eta_full[std::size_t(i)];
+    if (n.rfind("head_", 0) == 0 || n == "arm_7_joint") eta(i) = eta_dot(i) = 0;
+    else kept_eta.push_back(i);
+  }
+  const Eigen::MatrixXd S = c.S(q);
+  const VectorXd qd = S * eta, qdd = S * eta_dot + c.Sdot(q, qd) * eta;
+  const VectorXd ref = S.transpose() * (nhdyn::mass_matrix(full.model)(q) * qdd + nhdyn::bias(full.model)(q, qd));
+  const auto pick = [](const VectorXd& v, const std::vector<int>& idx) {
+    VectorXd out(static_cast<Eigen::Index>(idx.size()));
+    for (std::size_t k = 0; k < idx.size(); ++k) out(Eigen::Index(k)) = v(idx[k]);
+    return out;
+  };
+  const auto id = run_tool("id --model '" + file + "' " + lock, R"({"q": )" + arr(pick(q, kept_q)) + R"(, "eta": )" +
+                                                                    arr(pick(eta, kept_eta)) + R"(, "eta_dot": )" +
+                                                                    arr(pick(eta_dot, kept_eta)) + "}\n");
+  REQUIRE(id.status == 0);
+  const VectorXd want = pick(ref, kept_eta);
+  CHECK((field(id.lines[0], "tau") - want).norm() <= 1e-12 * std::max(1.0, want.norm()));
+
+  // errors name the culprit
+  r = run_tool("model --model '" + file + "' --lock 'base_x=0'");
+  CHECK(r.status != 0);
+  CHECK(r.err.find("'base_x' belongs to the constraint (differential_drive)") != std::string::npos);
+  r = run_tool("model --model '" + file + "' --lock 'gripper_*=0'");
+  CHECK(r.status != 0);
+  CHECK(r.err.find("'gripper_*' matches no movable joint") != std::string::npos);
+  r = run_tool("model --model '" + file + "' --lock 'arm_1_joint'");
+  CHECK(r.status == 2);
+  CHECK(r.err.find("'arm_1_joint' is not NAME=POSITION") != std::string::npos);
+  r = run_tool("model --model puma560 --lock 'joint1=0'");
+  CHECK(r.status != 0);
+  CHECK(r.err.find("--lock takes URDF files and robot files") != std::string::npos);
+}

@@ -6,7 +6,8 @@
 ///     {"name": "...", "urdf": "robot.urdf",              (the path relative to this file)
 ///      "gravity": [0, 0, -9.81],                          (optional, this default)
 ///      "base": {"type": "planar"},                        (optional; absent: fixed base)
-///      "constraint": {...}}                               (optional)
+///      "constraint": {...},                               (optional)
+///      "locked": {"NAME or GLOB": position, ...}}         (optional: joints held, model/lock.hpp)
 ///
 /// A planar base puts q = (base_x, base_y, base_yaw, the URDF's joints): the root link's pose
 /// on the floor. The constraints (docs/model-format.md and docs/theory.md give A, S, Ṡ):
@@ -25,6 +26,7 @@
 /// - `{"type": "wheeled_base", "wheels": [{"kind": "fixed" | "steered" | "castor" | "swedish",
 ///   "spin": J, …}, …], "eta": […], "actuated": […], "weights": {…}}` (planar base): any set of
 ///   wheels, each rim point at the floor not slipping (wheeled_base, docs/model-format.md).
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -35,6 +37,7 @@
 #include <vector>
 
 #include "../constraints/constraint.hpp"
+#include "../model/lock.hpp"
 #include "json.hpp"
 #include "urdf.hpp"
 
@@ -53,6 +56,9 @@ struct robot_model {
   json constraint_source{};
   std::string path{};
   bool planar_base = false;
+  /// The joints held by "locked" (or lock_robot), by name with their positions, in the full
+  /// tree's q order; `model` is the tree without them.
+  std::vector<std::pair<std::string, double>> locked{};
 
   /// Names of η's entries: the constraint's (`eta_names` of its type), or the joint names.
   std::vector<std::string> eta_names() const {
@@ -111,7 +117,7 @@ inline double axis_sign(const Eigen::Vector3d& a, int e, const std::string& wher
   for (int i = 0; i < 3; ++i)
     if (i != e) off = std::max(off, std::abs(a(i)));
   std::ostringstream os;
-  os << where << "the joint axis in the root link's frame is (" << a.x() << ", " << a.y() << ", " << a.z()
+  os << where << "its axis in the root link's frame is (" << a.x() << ", " << a.y() << ", " << a.z()
      << "), not " << need;
   if (off > 1e-3) throw model_error(os.str());
   if (off > 1e-9) {
@@ -227,8 +233,8 @@ inline robot_constraint read_robot_constraint(const json& c, const tree<double>&
       if (l == rt) throw model_error(at.prefix + ": left and right name the same joint '" + t[l].joint_name + "'");
       const auto L = joint_on_root_link(t, l, at, "left", "a drive wheel");
       const auto R = joint_on_root_link(t, rt, at, "right", "a drive wheel");
-      const double sl = axis_sign(L.axis, 1, at.field("left"), "horizontal and lateral (±y)", opt);
-      const double sr = axis_sign(R.axis, 1, at.field("right"), "horizontal and lateral (±y)", opt);
+      const double sl = axis_sign(L.axis, 1, at.field("left") + "joint '" + t[l].joint_name + "': ", "horizontal and lateral (±y)", opt);
+      const double sr = axis_sign(R.axis, 1, at.field("right") + "joint '" + t[rt].joint_name + "': ", "horizontal and lateral (±y)", opt);
       if (std::abs(L.origin.x() - R.origin.x()) > 1e-6) {
         std::ostringstream os;
         os << at.prefix << ": the wheels are not on one axle: their centres are at x = " << L.origin.x() << " and "
@@ -250,7 +256,7 @@ inline robot_constraint read_robot_constraint(const json& c, const tree<double>&
       if (!(L > 0)) throw model_error(at.field("wheelbase") + "must be positive, not " + format_number(L));
       const int s = named_joint(c, t, at, "steer");
       const auto J = joint_on_root_link(t, s, at, "steer", "the steering joint");
-      const double sign = axis_sign(J.axis, 2, at.field("steer"), "vertical (±z)", opt);
+      const double sign = axis_sign(J.axis, 2, at.field("steer") + "joint '" + t[s].joint_name + "': ", "vertical (±z)", opt);
       if (std::abs(J.origin.x() - L) > 1e-3 || std::abs(J.origin.y()) > 1e-3) {
         std::ostringstream os;
         os << at.prefix << ": the steering joint '" << t[s].joint_name << "' is at (" << J.origin.x() << ", "
@@ -300,13 +306,84 @@ inline tree<double> with_drives(const tree<double>& t, const json& d, const plac
 }
 }  // namespace detail
 
+namespace detail {
+/// The joints a constraint's rows involve: a nonzero column of A at either of two
+/// configurations, or one that A, S or Ṡ depend on (`depends_on`).
+template <class C>
+std::vector<bool> constraint_joints(const C& c, int n) {
+  std::vector<bool> used(std::size_t(n), false);
+  for (int trial = 0; trial < 2; ++trial) {
+    Eigen::VectorXd q(n);
+    for (int j = 0; j < n; ++j) q(j) = 0.3 * std::sin(1.7 * j + 0.4 + 1.1 * trial);
+    const Eigen::MatrixXd A = c.A(q);
+    for (int j = 0; j < n; ++j)
+      if (A.col(j).cwiseAbs().maxCoeff() > 0) used[std::size_t(j)] = true;
+  }
+  if constexpr (has_depends_on<C>)
+    for (int j = 0; j < n; ++j)
+      if (c.depends_on(j)) used[std::size_t(j)] = true;
+  return used;
+}
+
+/// A "locked" object: {"NAME or GLOB": position, ...}.
+inline std::vector<std::pair<std::string, double>> read_locked(const json& l, const place& top) {
+  if (!l.is_object())
+    throw model_error(top.field("locked") + "expected an object {\"joint name or glob\": position, ...}, got " + describe(l));
+  std::vector<std::pair<std::string, double>> out;
+  for (auto it = l.begin(); it != l.end(); ++it) {
+    if (!it.value().is_number() || !std::isfinite(it.value().get<double>()))
+      throw model_error(top.field("locked") + "'" + it.key() + "': expected a finite position [rad or m], got " +
+                        (it.value().is_number() ? std::string("a non-finite number") : describe(it.value())));
+    out.emplace_back(it.key(), it.value().get<double>());
+  }
+  return out;
+}
+}  // namespace detail
+
+/// The robot r with the joints that `locks` names or globs held at the given positions
+/// (model/lock.hpp's lock on its tree); its constraint is read again on the smaller tree. A
+/// joint the constraint involves (the planar base's, a wheel's, a castor's) cannot be
+/// locked: model_error naming it and the constraint. `where` begins every message.
+inline robot_model lock_robot(robot_model r, const std::vector<std::pair<std::string, double>>& locks,
+                              const std::string& where) {
+  if (locks.empty()) return r;
+  lock_map m;
+  try {
+    m = lock_map_of(r.model, locks);
+  } catch (const model_error& e) {
+    throw model_error(where + e.what());
+  }
+  const auto joints = r.model.joint_names();
+  if (r.constraint) {
+    const std::vector<bool> used =
+        std::visit([&](const auto& c) { return detail::constraint_joints(c, r.model.dof()); }, *r.constraint);
+    const std::string type = r.constraint_source.is_object() && r.constraint_source.contains("type") &&
+                                     r.constraint_source["type"].is_string()
+                                 ? r.constraint_source["type"].get<std::string>()
+                                 : std::string("the robot's");
+    for (const auto& [i, x] : m.locked)
+      if (used[std::size_t(i)])
+        throw model_error(where + "joint '" + joints[std::size_t(i)] + "' belongs to the constraint (" + type +
+                          "): its rows involve it, so it cannot be locked");
+  }
+  r.model = lock_indices(r.model, m.locked);
+  for (const auto& [i, x] : m.locked) r.locked.emplace_back(joints[std::size_t(i)], x);
+  if (!r.constraint_source.is_null()) {
+    urdf_options opt;
+    opt.planar_base = r.planar_base;
+    opt.warn = [](const std::string&) {};  // given when the full robot was read
+    r.constraint = detail::read_robot_constraint(r.constraint_source, r.model, detail::place{"robot file '" + r.path + "', locked"}, opt);
+  }
+  return r;
+}
+
 /// The robot file's text; `path` locates the URDF (relative paths from its folder) and names
 /// the file in messages.
 inline robot_model parse_robot_file(const std::string& text, const std::string& path, urdf_options opt = {}) {
   const std::string where = "robot file '" + path + "': ";
   const json j = parse_strict(text, where);
   if (!j.is_object()) throw model_error(where + "expected a JSON object, got " + detail::describe(j));
-  detail::check_keys(j, {"name", "description", "urdf", "gravity", "base", "drives", "constraint"}, {"urdf"}, where,
+  detail::check_keys(j, {"name", "description", "urdf", "gravity", "base", "drives", "constraint", "locked"}, {"urdf"}, where,
                      "a robot file");
   const detail::place top{"robot file '" + path + "'"};
   if (!j["urdf"].is_string()) throw model_error(top.field("urdf") + "expected a path, got " + detail::describe(j["urdf"]));
@@ -329,6 +406,10 @@ inline robot_model parse_robot_file(const std::string& text, const std::string& 
   if (j.contains("constraint")) out.constraint_source = j["constraint"];
   out.path = path;
   out.planar_base = opt.planar_base;
+  if (j.contains("locked")) {
+    const auto locks = detail::read_locked(j["locked"], top);
+    out = lock_robot(std::move(out), locks, top.field("locked"));
+  }
   return out;
 }
 

@@ -118,12 +118,45 @@ inline urdf_document read_document(const std::string& text, const std::string& w
 
 inline bool finite3(const Eigen::Vector3d& v) { return v.allFinite(); }
 
+/// The joints of a cycle in the document, as "'j1' (line 4), 'j2' (line 9)", if its joints
+/// form one (urdfdom says only "no root link"); empty otherwise. A link with two parent
+/// joints is left to urdfdom, which names it.
+inline std::string joint_cycle(const urdf_document& doc) {
+  std::map<std::string, const joint_element*> parent_joint;  // child link → its joint
+  for (const auto& j : doc.joints) {
+    if (j.child.empty() || j.parent.empty()) continue;
+    if (parent_joint.count(j.child)) return {};
+    parent_joint[j.child] = &j;
+  }
+  for (const auto& [start, unused] : parent_joint) {
+    std::vector<const joint_element*> path;
+    std::map<std::string, std::size_t> seen;  // link → its place on the path
+    for (std::string link = start;;) {
+      const auto it = parent_joint.find(link);
+      if (it == parent_joint.end()) break;  // reached a root
+      if (const auto s = seen.find(link); s != seen.end()) {
+        std::string out;
+        for (std::size_t k = s->second; k < path.size(); ++k)
+          out += (out.empty() ? "'" : ", '") + path[k]->name + "' (line " + std::to_string(path[k]->line) + ")";
+        return out;
+      }
+      seen[link] = path.size();
+      path.push_back(it->second);
+      link = it->second->parent;
+    }
+  }
+  return {};
+}
+
 }  // namespace detail
 
 /// A URDF document (its text) as a tree. `where` names it in messages (a file name).
 inline tree<double> parse_urdf(const std::string& text, const std::string& where = "URDF", urdf_options opt = {}) {
   const std::string at = where + ": ";
   const detail::urdf_document doc = detail::read_document(text, at);
+  if (const std::string cycle = detail::joint_cycle(doc); !cycle.empty())
+    throw model_error(at + "the joints form a cycle (" + cycle +
+                      "): every link on it has a parent, so there is no root link; a URDF is a tree");
   urdf::ModelInterfaceSharedPtr model;
   std::vector<std::string> urdfdom_warnings;
   {
@@ -311,7 +344,8 @@ inline tree<double> parse_urdf(const std::string& text, const std::string& where
   if (visits.size() != model->links_.size())
     for (const auto& [name, l] : model->links_)
       if (!visits.count(name)) throw model_error(at + "link '" + name + "'" + line_of_link(name) + " is not connected to the root '" + root->name + "'");
-  if (bodies.empty()) throw model_error(at + "no movable joint (revolute, continuous or prismatic)");
+  // no movable joint: a model of 0 joints (a bare base, a sensor head), its links frames of the
+  // root, as KDL loads such files
   validation v;
   v.triangle_inequality = false;  // checked per link above (warning or error)
   v.positive_semidefinite = false;

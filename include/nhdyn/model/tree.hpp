@@ -155,7 +155,8 @@ bool is_rotation(const mat3<S>& R, double tol = std::is_same_v<S, float> ? 1e-5 
 
 }  // namespace detail
 
-/// A kinematic tree of n = dof() bodies in the number type S (any nhdyn::scalar).
+/// A kinematic tree of n = dof() bodies in the number type S (any nhdyn::scalar). n may be 0:
+/// the base alone with its named frames (every joint locked, model/lock.hpp).
 template <scalar S>
 class tree {
  public:
@@ -170,7 +171,6 @@ class tree {
        std::string root = "base", std::vector<frame<S>> frames = {})
       : bodies_(std::move(bodies)), frames_(std::move(frames)), gravity_(std::move(gravity)),
         name_(std::move(name)), root_(std::move(root)), validation_(v) {
-    if (bodies_.empty()) throw model_error("model '" + name_ + "': a tree needs at least one moving body");
     for (int r = 0; r < 3; ++r)
       if (!is_finite_scalar(gravity_(r)))
         throw model_error("model '" + name_ + "', field 'gravity': is not finite (NaN or Inf)");
