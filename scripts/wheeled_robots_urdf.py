@@ -20,21 +20,9 @@ import math
 import os
 import sys
 
-PI2 = repr(math.pi / 2)
-
-
-def box(m, x, y, z):
-    return m * (y * y + z * z) / 12, m * (x * x + z * z) / 12, m * (x * x + y * y) / 12
-
-
-def cylinder(m, r, h):  # axis along z
-    side = m * (3 * r * r + h * h) / 12
-    return side, side, m * r * r / 2
-
-
-def inertial(m, com, I, rpy="0 0 0"):
-    return (f'    <inertial>\n      <origin xyz="{com}" rpy="{rpy}"/>\n      <mass value="{m:g}"/>\n'
-            f'      <inertia ixx="{I[0]:.6g}" ixy="0" ixz="0" iyy="{I[1]:.6g}" iyz="0" izz="{I[2]:.6g}"/>\n    </inertial>\n')
+# the inertia formulas and the <inertial>/<joint> writers of the mobile manipulator's script
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mobile_manipulator_urdf import PI2, box, cylinder, inertial, joint  # noqa: E402
 
 
 def visual(shape, xyz="0 0 0", rpy="0 0 0", material="grey"):
@@ -57,18 +45,6 @@ def link(name, m=None, com="0 0 0", I=None, rpy="0 0 0", visuals=()):
     for v in visuals:
         s += v
     return s + "  </link>\n"
-
-
-def joint(name, kind, parent, child, xyz, rpy="0 0 0", axis=None, limit=None, dynamics=None):
-    s = (f'  <joint name="{name}" type="{kind}">\n    <parent link="{parent}"/>\n    <child link="{child}"/>\n'
-         f'    <origin xyz="{xyz}" rpy="{rpy}"/>\n')
-    if axis:
-        s += f'    <axis xyz="{axis}"/>\n'
-    if limit:
-        s += f'    <limit lower="{limit[0]}" upper="{limit[1]}" effort="{limit[2]}" velocity="{limit[3]}"/>\n'
-    if dynamics:
-        s += f'    <dynamics damping="{dynamics[0]}" friction="{dynamics[1]}"/>\n'
-    return s + "  </joint>\n"
 
 
 def header(name, what):

@@ -304,9 +304,7 @@ inline tree<double> with_drives(const tree<double>& t, const json& d, const plac
     throw model_error(top.field("drives") + e.what());
   }
 }
-}  // namespace detail
 
-namespace detail {
 /// The joints a constraint's rows involve: a nonzero column of A at either of two
 /// configurations, or one that A, S or Ṡ depend on (`depends_on`).
 template <class C>

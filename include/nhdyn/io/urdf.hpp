@@ -232,15 +232,7 @@ inline tree<double> parse_urdf(const std::string& text, const std::string& where
     const Eigen::Matrix3d R_li = detail::rotation(in.origin.rotation);
     const Eigen::Matrix3d I_b = pl.R * R_li * Ic * R_li.transpose() * pl.R.transpose();
     const Eigen::Vector3d c_b = pl.p + pl.R * c_link;
-    body<double>& b = bodies[static_cast<std::size_t>(pl.body)];
-    const double m = b.mass + in.mass;
-    const Eigen::Vector3d c = m > 0 ? Eigen::Vector3d((b.mass * b.com + in.mass * c_b) / m) : Eigen::Vector3d::Zero();
-    const auto shift = [](double mass, const Eigen::Vector3d& d) {
-      return Eigen::Matrix3d(mass * (d.dot(d) * Eigen::Matrix3d::Identity() - d * d.transpose()));
-    };
-    b.inertia = b.inertia + shift(b.mass, b.com - c) + I_b + shift(in.mass, c_b - c);
-    b.com = c;
-    b.mass = m;
+    nhdyn::detail::merge_rigid_body(bodies[static_cast<std::size_t>(pl.body)], in.mass, c_b, I_b);
   };
 
   // Depth-first pre-order from the root, siblings in document order.

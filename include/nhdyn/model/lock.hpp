@@ -141,21 +141,6 @@ void locked_placement(const body<S>& b, double q, mat3<S>& R, vec3<S>& p) {
   p = b.p_PJ + b.R_PJ * vec3<S>(pj + Rj * b.p_JB);
 }
 
-/// Adds a rigid body (mass m, centre of mass c and inertia I about it, both in b's frame) to
-/// body b: the formulas of io/urdf.hpp's merge of a fixed link (parallel-axis theorem about
-/// the common centre of mass).
-template <class S>
-void merge_rigid_body(body<S>& b, const S& m, const vec3<S>& c, const mat3<S>& I) {
-  const S total = b.mass + m;
-  const vec3<S> cc = value_of(total) > 0 ? vec3<S>((b.mass * b.com + m * c) / total) : vec3<S>(vec3<S>::Zero());
-  const auto shift = [](const S& mass, const vec3<S>& d) {
-    return mat3<S>(mass * (d.dot(d) * mat3<S>::Identity() - d * d.transpose()));
-  };
-  b.inertia = mat3<S>(b.inertia + shift(b.mass, vec3<S>(b.com - cc)) + I + shift(m, vec3<S>(c - cc)));
-  b.com = cc;
-  b.mass = total;
-}
-
 inline std::string lock_where(const std::string& model) { return "model '" + model + "', lock: "; }
 
 inline std::string lock_number(double x) {

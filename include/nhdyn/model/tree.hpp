@@ -106,6 +106,21 @@ struct frame {
 
 namespace detail {
 
+/// Adds a rigid body (mass m, centre of mass c and inertia I about it, both in b's frame) to
+/// body b, about their common centre of mass (parallel-axis theorem): how io/urdf.hpp merges a
+/// fixed link and model/lock.hpp a locked body.
+template <class S>
+void merge_rigid_body(body<S>& b, const S& m, const vec3<S>& c, const mat3<S>& I) {
+  const S total = b.mass + m;
+  const vec3<S> cc = value_of(total) > 0 ? vec3<S>((b.mass * b.com + m * c) / total) : vec3<S>(vec3<S>::Zero());
+  const auto shift = [](const S& mass, const vec3<S>& d) {
+    return mat3<S>(mass * (d.dot(d) * mat3<S>::Identity() - d * d.transpose()));
+  };
+  b.inertia = mat3<S>(b.inertia + shift(b.mass, vec3<S>(b.com - cc)) + I + shift(m, vec3<S>(c - cc)));
+  b.com = cc;
+  b.mass = total;
+}
+
 /// What is wrong with a rigid body's (mass, inertia about the centre of mass), if anything
 /// that the policy rejects, as a sentence fragment; nullopt when it is acceptable. Mass ≥ 0
 /// and symmetry are always required; positive semi-definiteness and the triangle inequality
