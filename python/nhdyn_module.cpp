@@ -18,6 +18,7 @@
 #include <memory>
 #include <nhdyn/analysis/bounds.hpp>
 #include <nhdyn/analysis/linearize.hpp>
+#include <nhdyn/dynamics/terms.hpp>
 #include <nhdyn/io/json.hpp>
 #include <nhdyn/simulation/batch.hpp>
 #include <nhdyn/simulation/scene.hpp>
@@ -432,6 +433,51 @@ batch_function nh_id_wrenches_of(const Model& mdl, const C& c, const py::list& w
                                                              VectorXd(cmap(in[2], m))}).tau;
           }};
 }
+/// Python's terms= (a comma-separated string, or a list of names) and smooth= as nhdyn::terms.
+nhdyn::terms terms_from(const py::object& t, double smooth) {
+  std::string list;
+  if (py::isinstance<py::str>(t)) {
+    list = t.cast<std::string>();
+  } else {
+    for (const auto& x : t) list += (list.empty() ? "" : ",") + py::str(x).cast<std::string>();
+    if (list.empty()) list = "none";
+  }
+  auto r = nhdyn::terms::parse(list);
+  if (smooth != 0) {
+    if (!r.friction) throw nhdyn::input_error("smooth: the terms do not include friction");
+    r.coulomb = nhdyn::coulomb_law::smooth(smooth);
+  }
+  return r;
+}
+/// The friction the terms include: the model's, or none (zero laws, which add exactly 0).
+template <class Model>
+nhdyn::friction_fn terms_friction(const Model& mdl, const nhdyn::terms& t) {
+  return t.friction ? nhdyn::friction(mdl, t.coulomb)
+                    : nhdyn::friction_fn(std::vector<nhdyn::joint_friction>(static_cast<std::size_t>(mdl.dof())));
+}
+/// rne with the terms chosen (and the wrenches, if any): rne(model, t.rne()) + friction.
+template <class Model>
+batch_function rne_terms_of(const Model& full, const nhdyn::terms& t, const std::optional<py::list>& w) {
+  const Model mdl = nhdyn::with_terms(full, t);
+  const int n = mdl.dof();
+  const auto f = nhdyn::rne(mdl, t.rne()) + terms_friction(mdl, t);
+  const auto fx = nhdyn::external_wrenches(mdl, w ? wrenches_from(mdl, *w) : std::vector<nhdyn::wrench<double>>{});
+  return {"rne", {{"q", n}, {"qd", n}, {"qdd", n}}, {{"tau", n}}, [f, fx, n](const auto& in, const auto& out) {
+            vmap(out[0], n) = f(VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], n)), VectorXd(cmap(in[2], n)), fx);
+          }};
+}
+/// The nonholonomic inverse dynamics with the terms chosen: lift | rne + friction | wrenches | project.
+template <class Model, class C>
+batch_function nh_id_terms_of(const Model& full, const C& c, const nhdyn::terms& t, const std::optional<py::list>& w) {
+  const Model mdl = nhdyn::with_terms(full, t);
+  const int n = mdl.dof(), m = c.m(), p = nhdyn::actuator_count(c);
+  const auto fx = nhdyn::external_wrenches(mdl, w ? wrenches_from(mdl, *w) : std::vector<nhdyn::wrench<double>>{});
+  const auto f = nhdyn::lift(c) | (nhdyn::rne(mdl, t.rne()) + terms_friction(mdl, t)) | fx | nhdyn::constraint_forces(c);
+  return {"inverse_dynamics", {{"q", n}, {"eta", m}, {"eta_dot", m}}, {{"tau", p}}, [f, n, m, p](const auto& in, const auto& out) {
+            vmap(out[0], p) = f(nhdyn::reduced_state<double>{VectorXd(cmap(in[0], n)), VectorXd(cmap(in[1], m)),
+                                                             VectorXd(cmap(in[2], m))}).tau;
+          }};
+}
 template <class Model>
 batch_function holonomic_fd_wrenches_of(const Model& mdl, const py::list& w) {
   const int n = mdl.dof();
@@ -761,34 +807,47 @@ non-physical URDF inertia is an error instead of a warning on stderr. locked: {j
 or shell glob: position [rad or m]}: those joints held there, their links merged into their
 parents (URDF and robot files; a constraint's joints cannot be locked); Model.locked lists
 them. Raises ModelError with the file, link and field at fault.)");
-  mod.def("rne", [](const model& m, const std::optional<py::list>& w) {
+  mod.def("rne", [](const model& m, const std::optional<py::list>& w, const py::object& terms, double smooth) {
+            if (!terms.is_none() || smooth != 0) {
+              const auto t = terms_from(terms.is_none() ? py::str("gravity,velocity,armature") : terms, smooth);
+              return m.dispatch([&](const auto& x, const auto&) { return rne_terms_of(x, t, w); }, [&](const auto& x) { return rne_terms_of(x, t, w); });
+            }
             if (w && !w->empty()) return m.dispatch([&](const auto& x, const auto&) { return rne_wrenches_of(x, *w); }, [&](const auto& x) { return rne_wrenches_of(x, *w); });
             return m.dispatch([](const auto& x, const auto&) { return rne_of(x); }, [](const auto& x) { return rne_of(x); }); },
-          py::arg("model"), py::arg("wrenches") = py::none(),
-          R"(rne(model, wrenches=None) -> f(q, qd, qdd) -> tau
+          py::arg("model"), py::arg("wrenches") = py::none(), py::arg("terms") = py::none(), py::arg("smooth") = 0.0,
+          R"(rne(model, wrenches=None, terms=None, smooth=0) -> f(q, qd, qdd) -> tau
 
 The holonomic recursive Newton-Euler inverse dynamics tau = M(q) qdd + C(q, qd) qd + g(q)
 (+ armature qdd), n entries each [rad, rad/s, rad/s^2 or m, m/s, m/s^2 -> N m or N]. For a
 constrained model: of its stationary robot (all n joints). wrenches: external wrenches the
 environment applies, a list of {"body": name, "frame": "world" or "body", "point": [m, in
-the body frame], "force": [N], "moment": [N m]}: tau - sum J^T [f; m].)");
+the body frame], "force": [N], "moment": [N m]}: tau - sum J^T [f; m].
+terms: the terms to include, a list of names or a comma-separated string of gravity,
+velocity, armature, friction (or "all", "none"); None: gravity, velocity, armature (friction
+only when asked, as the tool's --terms). smooth: with friction, the Coulomb part smoothed
+at this velocity scale v_s > 0 [rad/s or m/s] (0: the exact sign law).)");
   mod.def("mass_matrix", [](const model& m) { return m.dispatch([](const auto& x, const auto&) { return mass_matrix_of(x); }, [](const auto& x) { return mass_matrix_of(x); }); },
           py::arg("model"), "mass_matrix(model) -> f(q) -> M (n x n, CRBA) [kg m^2, kg]");
   mod.def("bias", [](const model& m) { return m.dispatch([](const auto& x, const auto&) { return bias_of(x); }, [](const auto& x) { return bias_of(x); }); },
           py::arg("model"), "bias(model) -> f(q, qd) -> h = C(q, qd) qd + g(q) (n entries)");
   mod.def("inverse_dynamics",
-          [](const model& m, const std::optional<py::list>& w) {
+          [](const model& m, const std::optional<py::list>& w, const py::object& terms, double smooth) {
+            if (!terms.is_none() || smooth != 0) {
+              const auto t = terms_from(terms.is_none() ? py::str("gravity,velocity,armature") : terms, smooth);
+              return m.dispatch([&](const auto& x, const auto& c) { return nh_id_terms_of(x, c, t, w); },
+                                [&](const auto& x) { return rne_terms_of(x, t, w); });
+            }
             if (w && !w->empty())
               return m.dispatch([&](const auto& x, const auto& c) { return nh_id_wrenches_of(x, c, *w); },
                                 [&](const auto& x) { return rne_wrenches_of(x, *w); });
             return m.dispatch([](const auto& x, const auto& c) { return nh_id_of(x, c); }, [](const auto& x) { return rne_of(x); }); },
-          py::arg("model"), py::arg("wrenches") = py::none(),
-          R"(inverse_dynamics(model, wrenches=None) -> f(q, eta, eta_dot) -> tau
+          py::arg("model"), py::arg("wrenches") = py::none(), py::arg("terms") = py::none(), py::arg("smooth") = 0.0,
+          R"(inverse_dynamics(model, wrenches=None, terms=None, smooth=0) -> f(q, eta, eta_dot) -> tau
 
 The paper's nonholonomic inverse dynamics, project o rne o lift: q (n), eta and eta_dot (m,
 named by model.eta) -> tau (m actuator forces). A model without a constraint: eta = qd, and
 this is rne. wrenches: external wrenches as for rne, inside the pipeline (lift | rne |
-wrenches | project).)");
+wrenches | project). terms, smooth: as for rne (friction: lift | rne + friction | project).)");
   mod.def("lift",
           [](const model& m) {
             return m.dispatch([](const auto& x, const auto& c) { return lift_of(x, c); },

@@ -13,7 +13,7 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn bound --model MODEL [--strict] [--lock 'NAME=POS,...']
+const std::string usage = std::string(R"(nhdyn bound --model MODEL [--strict] [--lock 'NAME=POS,...'] [--terms LIST] [--smooth-coulomb VS]
   Guaranteed bounds on the torques over a box of states (interval arithmetic, outward rounding).
   Reads JSON lines on stdin, writes one JSON line per input line. Each box side is [lo, hi].
   Model with a constraint (n joints, m independent velocities, p actuators):
@@ -27,11 +27,7 @@ constexpr std::string_view usage = R"(nhdyn bound --model MODEL [--strict] [--lo
   Every true torque for every state in the box lies in the printed [lo, hi]: inputs are rounded
   outward, and printing rounds lo down and hi up. An unbounded enclosure is an error line naming
   the output (e.g. "tau[1]: the interval enclosure is unbounded ...").
-  --lock 'NAME=POS,GLOB=POS,...': hold those joints (URDF joint names or shell globs: *, ?,
-    [..]) at the positions [rad or m], their links merged into their parents; the model then
-    has the other joints only (URDF files and robot files; a constraint's joints cannot be
-    locked; `nhdyn model` lists what was locked).
-)";
+)") + std::string(model_options_help) + std::string(terms_help);
 
 nhdyn::box<nhdyn::dynamic> box_of(const line& l, std::string_view key, int n) {
   const Eigen::MatrixX2d m = l.intervals(key, n);
@@ -56,7 +52,8 @@ void keys(const line& l, std::vector<std::string> k) {
 
 /// Lines of a model with a constraint: boxes of (q, η, η̇) -> τ.
 template <class Model, class C>
-int constrained(const Model& model, const C& c, const std::string& name) {
+int constrained(const Model& model, const C& c, const std::string& name, const nhdyn::terms& t) {
+  const auto friction = friction_of(model, t);
   const int n = c.dof();
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("qd"))
@@ -64,27 +61,29 @@ int constrained(const Model& model, const C& c, const std::string& name) {
                                std::to_string(c.m()) + " entries)");
     keys(l, {"q", "eta", "eta_dot"});
     return reply(nhdyn::torque_bounds(model, c, box_of(l, "q", n), box_of(l, "eta", c.m()), box_of(l, "eta_dot", c.m()),
-                                      split_of(l)));
+                                      split_of(l), t.rne(), friction));
   });
 }
 /// Lines of a holonomic model: boxes of (q, q̇, q̈) -> τ.
 template <class Model>
-int holonomic(const Model& model, const std::string& name) {
+int holonomic(const Model& model, const std::string& name, const nhdyn::terms& t) {
+  const auto friction = friction_of(model, t);
   const int n = model.dof();
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("eta"))
       throw nhdyn::input_error("model '" + name + "' has no constraint: lines are {\"q\", \"qd\", \"qdd\"}");
     keys(l, {"q", "qd", "qdd"});
-    return reply(nhdyn::torque_bounds(model, box_of(l, "q", n), box_of(l, "qd", n), box_of(l, "qdd", n), split_of(l)));
+    return reply(nhdyn::torque_bounds(model, box_of(l, "q", n), box_of(l, "qd", n), box_of(l, "qdd", n), split_of(l), t.rne(),
+                                      friction));
   });
 }
 
 int run(const std::vector<std::string>& args) {
-  const auto any = start_any_model_command(args, usage);
+  const auto any = start_any_model_command(args, usage, true);
   if (!any) return 0;  // --help
   return dispatch(
-      *any, [&](const auto& model, const auto& c) { return constrained(model, c, any->name()); },
-      [&](const auto& model) { return holonomic(model, any->name()); });
+      *any, [&](const auto& model, const auto& c) { return constrained(model, c, any->name(), any->terms); },
+      [&](const auto& model) { return holonomic(model, any->name(), any->terms); });
 }
 }  // namespace
 

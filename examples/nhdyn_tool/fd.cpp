@@ -1,6 +1,7 @@
 /// \file fd.cpp
 /// `nhdyn fd`: forward dynamics on JSON lines. Holonomic models: q̈ = M⁻¹(τ − bias)
 /// (forward_dynamics). Models with a constraint: η̇ = M_η⁻¹(SᵀEτ − h_η) (nh_forward_dynamics).
+/// --terms: rne_options, and the friction in the bias (fd.with(friction(model))).
 #include <iostream>
 #include <nhdyn/dynamics/tree.hpp>
 #include <nhdyn/nhdyn.hpp>
@@ -10,7 +11,7 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn fd --model MODEL [--strict] [--lock 'NAME=POS,...']
+const std::string usage = std::string(R"(nhdyn fd --model MODEL [--strict] [--lock 'NAME=POS,...'] [--terms LIST] [--smooth-coulomb VS]
   Forward dynamics. Reads JSON lines on stdin, writes one JSON line per input line.
   Model without a constraint (n joints):
     {"q": [n], "qd": [n], "tau": [n]}        ->  {"qdd": [n]}         qdd = M(q)^-1 (tau - bias(q, qd))
@@ -21,17 +22,13 @@ constexpr std::string_view usage = R"(nhdyn fd --model MODEL [--strict] [--lock 
   Either form takes an optional "f_ext" (external wrenches, as `nhdyn id --help` describes):
   the motion they cause with tau.
   A singular or near-singular (reduced) mass matrix is an error line.
-  --strict: a URDF inertia that is not physically valid is an error instead of a warning.
-  --lock 'NAME=POS,GLOB=POS,...': hold those joints (URDF joint names or shell globs: *, ?,
-    [..]) at the positions [rad or m], their links merged into their parents; the model then
-    has the other joints only (URDF files and robot files; a constraint's joints cannot be
-    locked; `nhdyn model` lists what was locked).
-)";
+)") + std::string(model_options_help) + std::string(terms_help);
 
 /// Lines of a model with a constraint: (q, η, τ) -> η̇.
 template <class Model, class C>
-int constrained(const Model& model, const C& c, const std::string& name) {
-  const auto fd = nhdyn::nh_forward_dynamics(model, c);
+int constrained(const Model& model, const C& c, const std::string& name, const nhdyn::terms& t) {
+  const auto fd = t.friction ? nhdyn::nh_forward_dynamics(model, c, t.rne()).with(nhdyn::friction(model, t.coulomb))
+                             : nhdyn::nh_forward_dynamics(model, c, t.rne());
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("qd"))
       throw nhdyn::input_error("model '" + name + "' has a constraint: lines are {\"q\", \"eta\", \"tau\"} (eta has " +
@@ -45,8 +42,9 @@ int constrained(const Model& model, const C& c, const std::string& name) {
 }
 /// Lines of a holonomic model: (q, q̇, τ) -> q̈.
 template <class Model>
-int holonomic(const Model& model, const std::string& name) {
-  const auto fd = nhdyn::forward_dynamics(model);
+int holonomic(const Model& model, const std::string& name, const nhdyn::terms& t) {
+  const auto fd = t.friction ? nhdyn::forward_dynamics(model, t.rne()).with(nhdyn::friction(model, t.coulomb))
+                             : nhdyn::forward_dynamics(model, t.rne());
   const int n = model.dof();
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("eta"))
@@ -60,11 +58,11 @@ int holonomic(const Model& model, const std::string& name) {
 }
 
 int run(const std::vector<std::string>& args) {
-  const auto any = start_any_model_command(args, usage);
+  const auto any = start_any_model_command(args, usage, true);
   if (!any) return 0;  // --help
   return dispatch(
-      *any, [&](const auto& model, const auto& c) { return constrained(model, c, any->name()); },
-      [&](const auto& model) { return holonomic(model, any->name()); });
+      *any, [&](const auto& model, const auto& c) { return constrained(model, c, any->name(), any->terms); },
+      [&](const auto& model) { return holonomic(model, any->name(), any->terms); });
 }
 }  // namespace
 

@@ -1,7 +1,8 @@
 /// \file id.cpp
 /// `nhdyn id`: inverse dynamics on JSON lines. Holonomic models: τ = rne(q, q̇, q̈).
 /// Models with a constraint: (τ, λ) = inverse_dynamics_with_forces(q, η, η̇), i.e. the
-/// projection of rne ∘ lift (paper eqs. 18–19) and λ = (AAᵀ)⁻¹A(v − Eτ).
+/// projection of rne ∘ lift (paper eqs. 18–19) and λ = (AAᵀ)⁻¹A(v − Eτ). --terms chooses
+/// what rne includes, and puts rne + friction in its place (dynamics/terms.hpp).
 #include <iostream>
 #include <nhdyn/dynamics/tree.hpp>
 #include <nhdyn/nhdyn.hpp>
@@ -11,7 +12,7 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn id --model MODEL [--strict] [--lock 'NAME=POS,...']
+const std::string usage = std::string(R"(nhdyn id --model MODEL [--strict] [--lock 'NAME=POS,...'] [--terms LIST] [--smooth-coulomb VS]
   Inverse dynamics. Reads JSON lines on stdin, writes one JSON line per input line.
   Model without a constraint (n joints):
     {"q": [n], "qd": [n], "qdd": [n]}        ->  {"tau": [n]}         tau = rne(q, qd, qdd)
@@ -28,17 +29,18 @@ constexpr std::string_view usage = R"(nhdyn id --model MODEL [--strict] [--lock 
   body's frame [m]; force and moment in the world's or the body's axes; DH models name their
   bodies link1 ... linkN). tau (and lambda) are then what balances them as well.
   Keys must be exactly those of the model's form; anything else is an error line.
-  --strict: a URDF inertia that is not physically valid is an error instead of a warning.
-  --lock 'NAME=POS,GLOB=POS,...': hold those joints (URDF joint names or shell globs: *, ?,
-    [..]) at the positions [rad or m], their links merged into their parents; the model then
-    has the other joints only (URDF files and robot files; a constraint's joints cannot be
-    locked; `nhdyn model` lists what was locked).
-)";
+)") + std::string(model_options_help) + std::string(terms_help);
 
-/// Lines of a model with a constraint: (q, η, η̇) -> (τ, λ).
-template <class Model, class C>
-int constrained(const Model& model, const C& c, const std::string& name) {
-  const auto id = nhdyn::inverse_dynamics_with_forces(model, c);
+/// Lines of a model with a constraint: (q, η, η̇) -> (τ, λ); `dyn` is rne or rne + friction.
+template <class Model, class C, class Dyn>
+int constrained(const Model& model, const C& c, const std::string& name, const nhdyn::terms& t, const Dyn& dyn) {
+  // project ∘ rne ∘ lift (its fused path on a chain), or with friction in rne's place
+  const auto id = [&] {
+    if constexpr (std::is_same_v<Dyn, decltype(nhdyn::rne(model))>)
+      return nhdyn::inverse_dynamics_with_forces(model, c, t.rne());
+    else
+      return nhdyn::inverse_dynamics_with_forces(model, c, t.rne(), dyn.b);
+  }();
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("qd") || l.has("qdd"))
       throw nhdyn::input_error("model '" + name + "' has a constraint: lines are {\"q\", \"eta\", \"eta_dot\"} (eta has " +
@@ -50,14 +52,12 @@ int constrained(const Model& model, const C& c, const std::string& name) {
     };
     if (!l.has("f_ext")) return out(id(q, eta, eta_dot));
     const auto fx = nhdyn::external_wrenches(model, wrenches_of(l, model));
-    return out((nhdyn::lift(c) | nhdyn::rne(model) | fx | nhdyn::constraint_forces(c))(
-        nhdyn::reduced_state<double>{q, eta, eta_dot}));
+    return out((nhdyn::lift(c) | dyn | fx | nhdyn::constraint_forces(c))(nhdyn::reduced_state<double>{q, eta, eta_dot}));
   });
 }
-/// Lines of a holonomic model: (q, q̇, q̈) -> τ.
-template <class Model>
-int holonomic(const Model& model, const std::string& name) {
-  const auto id = nhdyn::rne(model);
+/// Lines of a holonomic model: (q, q̇, q̈) -> τ; `id` is rne or rne + friction.
+template <class Model, class Id>
+int holonomic(const Model& model, const std::string& name, const Id& id) {
   const int n = model.dof();
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("eta") || l.has("eta_dot"))
@@ -71,11 +71,17 @@ int holonomic(const Model& model, const std::string& name) {
 }
 
 int run(const std::vector<std::string>& args) {
-  const auto any = start_any_model_command(args, usage);
+  const auto any = start_any_model_command(args, usage, true);
   if (!any) return 0;  // --help
+  const auto& t = any->terms;
   return dispatch(
-      *any, [&](const auto& model, const auto& c) { return constrained(model, c, any->name()); },
-      [&](const auto& model) { return holonomic(model, any->name()); });
+      *any,
+      [&](const auto& model, const auto& c) {
+        return with_dynamics(model, t, [&](const auto& dyn) { return constrained(model, c, any->name(), t, dyn); });
+      },
+      [&](const auto& model) {
+        return with_dynamics(model, t, [&](const auto& dyn) { return holonomic(model, any->name(), dyn); });
+      });
 }
 }  // namespace
 

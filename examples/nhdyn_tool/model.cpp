@@ -9,7 +9,7 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn model --model MODEL [--strict] [--lock 'NAME=POS,...']
+const std::string usage = std::string(R"(nhdyn model --model MODEL [--strict] [--lock 'NAME=POS,...']
   Prints one JSON object describing MODEL:
     {"name": ..., "dof": n, "joints": [n names, q order], "eta": [m names], "tau": [p names],
      "k": k, "gravity": [gx, gy, gz]}
@@ -26,12 +26,7 @@ constexpr std::string_view usage = R"(nhdyn model --model MODEL [--strict] [--lo
   DH models name their joints joint1...jointn; a URDF's joints keep their names, movable
   joints only, in the documented order (docs/trees-and-urdf.md); a robot file's planar base
   adds base_x, base_y, base_yaw in front.
-  --strict: a URDF inertia that is not physically valid is an error instead of a warning.
-  --lock 'NAME=POS,GLOB=POS,...': hold those joints (URDF joint names or shell globs: *, ?,
-    [..]) at the positions [rad or m], their links merged into their parents; the model then
-    has the other joints only (URDF files and robot files; a constraint's joints cannot be
-    locked; `nhdyn model` lists what was locked).
-)";
+)") + std::string(model_options_help);
 
 ordered_json describe(const std::string& name, const std::vector<std::string>& joints, const std::vector<std::string>& eta,
                       const std::vector<std::string>& tau, int k, const Eigen::Vector3d& g) {

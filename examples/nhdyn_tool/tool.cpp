@@ -117,16 +117,44 @@ any_model load_any_model(const std::string& spec, bool strict, const std::vector
 #endif
 }
 
-std::optional<any_model> start_any_model_command(const std::vector<std::string>& args, std::string_view usage) {
+std::optional<any_model> start_any_model_command(const std::vector<std::string>& args, std::string_view usage,
+                                                 bool takes_terms) {
   CLI::App app;
   std::string model;
   bool strict = false;
-  std::string lock;
+  std::string lock, terms;
+  double smooth = 0;
   app.add_option("--model", model)->required();
   app.add_flag("--strict", strict);
   app.add_option("--lock", lock);
+  CLI::Option* terms_option = nullptr;
+  CLI::Option* smooth_option = nullptr;
+  if (takes_terms) {
+    terms_option = app.add_option("--terms", terms);
+    smooth_option = app.add_option("--smooth-coulomb", smooth);
+  }
   if (!parse_command_line(app, args, usage)) return std::nullopt;
-  return load_any_model(model, strict, lock.empty() ? std::vector<std::pair<std::string, double>>{} : parse_locks(lock));
+  nhdyn::terms t;
+  if (terms_option && terms_option->count() > 0) {
+    try {
+      t = nhdyn::terms::parse(terms);
+    } catch (const nhdyn::input_error& e) {
+      throw usage_error(std::string("--") + e.what());
+    }
+  }
+  if (smooth_option && smooth_option->count() > 0) {
+    if (!t.friction) throw usage_error("--smooth-coulomb: the terms do not include friction (--terms ...,friction)");
+    if (!(smooth > 0) || !std::isfinite(smooth))
+      throw usage_error("--smooth-coulomb: the velocity scale must be a finite number > 0, not " + std::to_string(smooth));
+    t.coulomb = nhdyn::coulomb_law::smooth(smooth);
+  }
+  auto any = load_any_model(model, strict, lock.empty() ? std::vector<std::pair<std::string, double>>{} : parse_locks(lock));
+  any.terms = t;
+  if (!t.armature) {
+    if (any.tree) any.tree = nhdyn::without_armature(*any.tree);
+    if (any.dh) any.dh->chain = nhdyn::without_armature(any.dh->chain);
+  }
+  return any;
 }
 
 nhdyn::io::model<double> load_model(const std::string& spec) {

@@ -16,6 +16,9 @@
 #include <optional>
 #include <variant>
 #include <nhdyn/constraints/constraint.hpp>
+#include <nhdyn/dynamics/friction.hpp>
+#include <nhdyn/dynamics/terms.hpp>
+#include <nhdyn/dynamics/tree.hpp>
 #include <nhdyn/dynamics/wrench.hpp>
 #include <nhdyn/io/json.hpp>
 #include <nhdyn/model/tree.hpp>
@@ -70,6 +73,9 @@ struct any_model {
   std::optional<nhdyn::base_constraint> tree_constraint;
   /// The joints held (the robot file's "locked" and --lock), by name, with their positions.
   std::vector<std::pair<std::string, double>> locked;
+  /// The terms the computation includes (--terms, --smooth-coulomb; the model's armature is
+  /// already dropped when they leave it out).
+  nhdyn::terms terms;
   const std::string& name() const { return dh ? dh->chain.name() : tree->name(); }
 };
 /// Calls `constrained(model, c)` for a model with a constraint (a DH chain with its
@@ -85,6 +91,22 @@ int dispatch(const any_model& a, const Constrained& constrained, const Holonomic
   return holonomic(a.dh->chain);
 }
 
+/// Calls f(dyn) with dyn the stage in rne's place as the terms say: rne(model, t.rne()), or
+/// rne(model, t.rne()) + friction(model, t.coulomb) (a sum_fn: its `b` is the friction).
+template <class Model, class F>
+int with_dynamics(const Model& model, const nhdyn::terms& t, const F& f) {
+  auto r = nhdyn::rne(model, t.rne());
+  if (t.friction) return f(r + nhdyn::friction(model, t.coulomb));
+  return f(r);
+}
+
+/// The friction the terms ask for (friction(model, t.coulomb)), if they include it.
+template <class Model>
+std::optional<nhdyn::friction_fn> friction_of(const Model& model, const nhdyn::terms& t) {
+  if (!t.friction) return std::nullopt;
+  return nhdyn::friction(model, t.coulomb);
+}
+
 /// Whether MODEL names a URDF file (its extension is .urdf, any case).
 bool is_urdf(const std::string& spec);
 /// load_model, URDF files (*.urdf) and robot files (JSON with a "urdf" key); `strict`: a non-physical inertia in a URDF is an error
@@ -95,8 +117,33 @@ any_model load_any_model(const std::string& spec, bool strict = false,
 /// The value of --lock, 'NAME=POSITION,GLOB=POSITION,...': usage_error naming a bad entry.
 std::vector<std::pair<std::string, double>> parse_locks(const std::string& text);
 /// start_model_command for the subcommands that take any model:
-/// `--model MODEL [--strict] [--lock 'NAME=POS,...']`.
-std::optional<any_model> start_any_model_command(const std::vector<std::string>& args, std::string_view usage);
+/// `--model MODEL [--strict] [--lock 'NAME=POS,...']`, and with `takes_terms`
+/// `[--terms LIST] [--smooth-coulomb VS]` (any_model::terms; an unknown term is a usage_error).
+std::optional<any_model> start_any_model_command(const std::vector<std::string>& args, std::string_view usage,
+                                                 bool takes_terms = false);
+
+/// The help of start_any_model_command's options, the end of each such subcommand's usage.
+inline constexpr std::string_view model_options_help =
+    R"(  --strict: a URDF inertia that is not physically valid is an error instead of a warning.
+  --lock 'NAME=POS,GLOB=POS,...': hold those joints (URDF joint names or shell globs: *, ?,
+    [..]) at the positions [rad or m], their links merged into their parents; the model then
+    has the other joints only (URDF files and robot files; a constraint's joints cannot be
+    locked; `nhdyn model` lists what was locked).
+)";
+/// The help of --terms and --smooth-coulomb.
+inline constexpr std::string_view terms_help =
+    R"(  --terms LIST: the terms of the equations of motion to include, comma-separated:
+    gravity   g(q)
+    velocity  C(q, qd) qd (Coriolis and centrifugal)
+    armature  the joints' reflected rotor inertia G^2 J_m (URDF files: none; DH models: a
+              link's "armature" or "motor")
+    friction  the joints' viscous and Coulomb friction (a link's "friction" or "motor", a
+              URDF joint's <dynamics damping friction>)
+    or all, or none. Default: gravity,velocity,armature (the rigid-body terms and armature,
+    as KDL's and Pinocchio's inverse dynamics): friction only when asked.
+  --smooth-coulomb VS: with friction, the Coulomb part c*qd/sqrt(qd^2 + VS^2) (VS > 0 in
+    rad/s or m/s) instead of the exact sign law (0 at rest, as the Robotics Toolbox).
+)";
 
 /// Where the tool's shipped data lives: `share/nhdyn` beside the folder of the running
 /// `nhdyn` (its `bin/`), as `cmake --install` and the build tree (`build/bin/nhdyn`,

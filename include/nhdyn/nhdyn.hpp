@@ -8,6 +8,7 @@
 #include "dynamics/friction.hpp"
 #include "dynamics/mass_matrix.hpp"
 #include "dynamics/rne.hpp"
+#include "dynamics/terms.hpp"
 #include "dynamics/wrench.hpp"
 #include "errors.hpp"
 #include "functional/compose.hpp"

@@ -480,3 +480,41 @@ def test_locked_joints_from_python():
         nhdyn.load(path, locked={"wheel_left_joint": 0.0})
     with pytest.raises(nhdyn.ModelError, match="'finger_\\*' matches no movable joint"):
         nhdyn.load(path, locked={"finger_*": 0.0})
+
+
+def test_terms_from_python():
+    """rne(terms=...) and inverse_dynamics(terms=...): the Robotics Toolbox's rne(qn, 1, 1)
+    (friction included) on puma560_motors, the tool's --terms numbers, and a robot file whose
+    friction (URDF damping) the constrained pipeline includes only when asked."""
+    p = nhdyn.load("puma560_motors")
+    qn = np.array([0, np.pi / 4, np.pi, 0, np.pi / 4, 0])
+    o = np.ones(6)
+    tau = nhdyn.rne(p, terms="gravity,velocity,armature,friction")(qn, o, o)
+    assert np.allclose(tau, [32.4952, 60.867, 17.7436, 1.45452, 1.29911, 0.713781], rtol=0, atol=0.5e-4)
+    assert np.array_equal(nhdyn.rne(p, terms=["gravity", "velocity", "armature"])(qn, o, o), nhdyn.rne(p)(qn, o, o))
+    line = {"q": list(qn), "qd": list(o), "qdd": list(o)}
+    for t in ("all", "velocity,armature", "none"):
+        got = nhdyn.rne(p, terms=t)(qn, o, o)
+        assert np.array_equal(np.array(tool(["id", "--model", "puma560_motors", "--terms", t], [line])[0]["tau"]), got)
+    smooth = nhdyn.rne(p, terms="all", smooth=0.01)(qn, o, o)
+    assert np.all(smooth < tau) and np.all(tau - smooth < 2e-3)  # 1 − v_s²/(2q̇²) of |G|Tc⁺ ≤ 25 N m
+    with pytest.raises(nhdyn.InputError, match="no term named 'coriolis'"):
+        nhdyn.rne(p, terms="gravity,coriolis")
+    with pytest.raises(nhdyn.InputError, match="do not include friction"):
+        nhdyn.rne(p, terms="gravity", smooth=0.1)
+    path = os.path.join(SOURCE, "examples", "robots", "mobile_manipulator_castors.json")
+    try:
+        r = nhdyn.load(path)
+    except nhdyn.ModelError as e:
+        if "without URDF support" in str(e):
+            pytest.skip(str(e))
+        raise
+    rng = np.random.default_rng(4)
+    q, eta, eta_dot = rng.uniform(-1, 1, r.dof), rng.uniform(-1, 1, r.m), rng.uniform(-1, 1, r.m)
+    with_f = nhdyn.inverse_dynamics(r, terms="all")(q, eta, eta_dot)
+    assert np.allclose(nhdyn.inverse_dynamics(r, terms="gravity,velocity,armature")(q, eta, eta_dot),
+                       nhdyn.inverse_dynamics(r)(q, eta, eta_dot), rtol=1e-12, atol=1e-12)
+    assert np.max(np.abs(with_f - nhdyn.inverse_dynamics(r)(q, eta, eta_dot))) > 1e-3
+    line = {"q": list(q), "eta": list(eta), "eta_dot": list(eta_dot)}
+    assert np.allclose(np.array(tool(["id", "--model", path, "--terms", "all"], [line])[0]["tau"]), with_f,
+                       rtol=1e-12, atol=1e-12)

@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -336,4 +337,163 @@ TEST_CASE("tool: --lock holds joints of a robot file: model lists them, id equal
   r = run_tool("model --model puma560 --lock 'joint1=0'");
   CHECK(r.status != 0);
   CHECK(r.err.find("--lock takes URDF files and robot files") != std::string::npos);
+}
+
+TEST_CASE("tool: --terms on puma560_motors reproduces the Robotics Toolbox's rne(qn, 1, 1); each term off removes its part") {
+  // robotics-toolbox-python tests/test_DHRobot.py (test_rne, test_itorque): its rne includes the
+  // drives' armature G²J_m q̈, viscous G²B q̇ and Coulomb |G|Tc; qn = (0, π/4, π, 0, π/4, 0).
+  const std::string qn = "[0, 0.7853981633974483, 3.141592653589793, 0, 0.7853981633974483, 0]";
+  const auto id = [&](const std::string& terms, const std::string& qd, const std::string& qdd) {
+    const auto r = run_tool("id --model puma560_motors" + (terms.empty() ? std::string() : " --terms '" + terms + "'"),
+                            "{\"q\": " + qn + ", \"qd\": " + qd + ", \"qdd\": " + qdd + "}\n");
+    INFO("terms " << terms << ": " << r.err);
+    REQUIRE(r.status == 0);
+    REQUIRE(r.lines.size() == 1);
+    return field(r.lines[0], "tau");
+  };
+  // to the printed digits: within half a unit of the last one
+  const auto printed = [](const VectorXd& x, const std::vector<std::string>& p) {
+    REQUIRE(x.size() == Eigen::Index(p.size()));
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const auto dot = p[i].find('.');
+      const int decimals = dot == std::string::npos ? 0 : int(p[i].size() - dot - 1);
+      INFO("entry " << i << ": " << x(Eigen::Index(i)) << " printed " << p[i]);
+      CHECK(std::abs(x(Eigen::Index(i)) - std::stod(p[i])) <= 0.5 * std::pow(10.0, -decimals) + 1e-12);
+    }
+  };
+  const std::string o = "[1, 1, 1, 1, 1, 1]", z = "[0, 0, 0, 0, 0, 0]", q123 = "[1, 2, 3, 1, 2, 3]";
+  const VectorXd all = id("gravity,velocity,armature,friction", o, o);
+  printed(all, {"32.4952", "60.867", "17.7436", "1.45452", "1.29911", "0.713781"});  // rne(qn, 1, 1)
+  const VectorXd rtb_qd = id("gravity,velocity,armature,friction", o, z);
+  printed(rtb_qd, {"29.1421", "56.5044", "16.3528", "1.26448", "1.12392", "0.519648"});  // rne(qn, 1, 0)
+  CHECK(id("all", o, o) == all);
+  CHECK(id("friction, armature,velocity,gravity", o, o) == all);  // any order, spaces ignored
+  CHECK(id("", o, o) == id("gravity,velocity,armature", o, o));  // the default: no friction
+
+  // Corke's published drive parameters (Puma560.m; typed here, not taken from the preset)
+  const double Jm[6] = {200e-6, 200e-6, 200e-6, 33e-6, 33e-6, 33e-6};
+  const double G[6] = {-62.6111, 107.815, -53.7063, 76.0364, 71.923, 76.686};
+  const double B[6] = {1.48e-3, .817e-3, 1.38e-3, 71.2e-6, 82.6e-6, 36.7e-6};
+  const double Tc_pos[6] = {.395, .126, .132, 11.2e-3, 9.26e-3, 3.96e-3};
+  VectorXd armature(6), friction_at_1(6);
+  for (int i = 0; i < 6; ++i) {
+    armature(i) = G[i] * G[i] * Jm[i];
+    friction_at_1(i) = G[i] * G[i] * B[i] + std::abs(G[i]) * Tc_pos[i];
+  }
+  const auto near = [](const VectorXd& a, const VectorXd& b, double tol) {
+    INFO(a.transpose() << "\n vs " << b.transpose());
+    CHECK((a - b).cwiseAbs().maxCoeff() <= tol);
+  };
+  // each term switched off changes exactly its part
+  near(all - id("gravity,velocity,friction", o, o), armature, 1e-12);      // G²J_m q̈, q̈ = 1
+  near(all - id("gravity,velocity,armature", o, o), friction_at_1, 1e-12);  // G²B + |G|Tc⁺ at q̇ = 1
+  // gravity: the toolbox's rne(qn, 0, 0) (friction is 0 at rest, armature at q̈ = 0)
+  printed(all - id("velocity,armature,friction", o, o), {"-0.0000", "31.6399", "6.0351", "0.0000", "0.0283", "0"});
+  // velocity: C(q, q̇)q̇ = the toolbox's rne(qn, 1, 0) − rne(qn, 0, 0) − the friction at q̇ = 1
+  VectorXd gravity(6);
+  gravity << 0, 31.6399, 6.0351, 0, 0.0283, 0;
+  VectorXd rtb_qd_printed(6);
+  rtb_qd_printed << 29.1421, 56.5044, 16.3528, 1.26448, 1.12392, 0.519648;
+  near(all - id("gravity,armature,friction", o, o), rtb_qd_printed - gravity - friction_at_1, 1e-4);
+  // none: the rigid bodies' M(q) q̈ alone = the toolbox's itorque (M with armature) − G²J_m q̈
+  VectorXd itorque(6), qdd(6);
+  itorque << 3.1500, 9.4805, 3.6189, 0.1901, 0.3519, 0.5823;
+  qdd << 1, 2, 3, 1, 2, 3;
+  near(id("none", o, q123), itorque - armature.cwiseProduct(qdd), 0.5e-4 + 1e-12);
+  // smooth Coulomb: at q̇ = 1 within 1 − v_s²/(2q̇²) of the exact law (v_s = 0.01: 5e-5 relative)
+  const auto r = run_tool("id --model puma560_motors --terms all --smooth-coulomb 0.01",
+                          "{\"q\": " + qn + ", \"qd\": " + o + ", \"qdd\": " + o + "}\n");
+  REQUIRE(r.status == 0);
+  const VectorXd smooth = field(r.lines[0], "tau");
+  for (int i = 0; i < 6; ++i) {
+    const double coulomb = std::abs(G[i]) * Tc_pos[i];
+    CHECK(all(i) - smooth(i) > 0);
+    CHECK(all(i) - smooth(i) <= coulomb * 0.5e-4 * 1.01);
+  }
+
+  SECTION("errors name the term, exit status 2") {
+    for (const std::string bad : {"gravity,bogus", "gravity,,velocity", "gravity,gravity"}) {
+      const auto e = run_tool("id --model puma560_motors --terms '" + bad + "'", "");
+      CHECK(e.status == 2);
+      CHECK(e.err.find("--terms '" + bad + "'") != std::string::npos);
+    }
+    CHECK(run_tool("id --model puma560_motors --terms gravity --smooth-coulomb 0.1", "").err.find("do not include friction") !=
+          std::string::npos);
+    CHECK(run_tool("model --model puma560_motors --terms all", "").status == 2);  // model has no terms
+  }
+}
+
+TEST_CASE("tool: --terms friction in fd, linearize and bound agrees with id's (DH chain and a robot file)") {
+  const std::string robot = std::string(NHDYN_SOURCE_DIR) + "/examples/robots/mobile_manipulator_castors.json";
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const auto rand_vec = [&](int n) {
+    VectorXd v(n);
+    for (int i = 0; i < n; ++i) v(i) = u(rng);
+    return v;
+  };
+  for (const bool constrained : {false, true}) {
+    const std::string spec = constrained ? "'" + robot + "'" : "puma560_motors";
+    const auto desc = json::parse(run_tool("model --model " + spec).lines.at(0));
+    const int n = desc["dof"], m = int(desc["eta"].size());
+    const std::string v = constrained ? "eta" : "qd", a = constrained ? "eta_dot" : "qdd";
+    const VectorXd q = rand_vec(n), vel = rand_vec(m), acc = rand_vec(m);
+    INFO(spec);
+    const auto r_id = run_tool("id --model " + spec + " --terms all",
+                               "{\"q\": " + arr(q) + ", \"" + v + "\": " + arr(vel) + ", \"" + a + "\": " + arr(acc) + "}\n");
+    REQUIRE(r_id.status == 0);
+    const VectorXd tau = field(r_id.lines[0], "tau");
+    // fd with friction inverts id with friction; without it, it does not
+    const std::string fd_in = "{\"q\": " + arr(q) + ", \"" + v + "\": " + arr(vel) + ", \"tau\": " + arr(tau) + "}\n";
+    const auto with = run_tool("fd --model " + spec + " --terms all", fd_in);
+    const auto without = run_tool("fd --model " + spec, fd_in);
+    REQUIRE(with.status == 0);
+    REQUIRE(without.status == 0);
+    const VectorXd back = field(with.lines[0], constrained ? "eta_dot" : "qdd");
+    CHECK((back - acc).cwiseAbs().maxCoeff() <= 1e-9);
+    CHECK((field(without.lines[0], constrained ? "eta_dot" : "qdd") - acc).cwiseAbs().maxCoeff() > 1e-3);
+    // linearize with friction (smooth, so differentiable): its B = ∂f/∂τ against central
+    // differences of fd with friction in τ (h = 1e-6)
+    const std::string smooth = " --terms all --smooth-coulomb 0.05";
+    const auto lin = run_tool("linearize --model " + spec + smooth, fd_in);
+    REQUIRE(lin.status == 0);
+    const json L = json::parse(lin.lines[0]);
+    std::string lines;
+    const double h = 1e-6;
+    for (int j = 0; j < int(tau.size()); ++j)
+      for (const double s : {h, -h}) {
+        VectorXd t = tau;
+        t(j) += s;
+        lines += "{\"q\": " + arr(q) + ", \"" + v + "\": " + arr(vel) + ", \"tau\": " + arr(t) + "}\n";
+      }
+    const auto fd_lines = run_tool("fd --model " + spec + smooth, lines);
+    REQUIRE(fd_lines.status == 0);
+    const int nx = constrained ? n + m : 2 * n;
+    double worst = 0;
+    for (int j = 0; j < int(tau.size()); ++j) {
+      const VectorXd d = (field(fd_lines.lines[std::size_t(2 * j)], constrained ? "eta_dot" : "qdd") -
+                          field(fd_lines.lines[std::size_t(2 * j + 1)], constrained ? "eta_dot" : "qdd")) / (2 * h);
+      for (int i = 0; i < m; ++i) worst = std::max(worst, std::abs(L["B"][std::size_t(nx - m + i)][std::size_t(j)].get<double>() - d(i)));
+    }
+    CHECK(worst <= 1e-5);
+    // A's velocity column block carries the friction's slope: it differs from the frictionless one
+    const auto lin0 = run_tool("linearize --model " + spec, fd_in);
+    REQUIRE(lin0.status == 0);
+    CHECK(L["A"] != json::parse(lin0.lines[0])["A"]);
+    // bound with friction encloses id's torque at the box's centre
+    std::string box = "{";
+    for (const auto& [key, x] : {std::pair<std::string, VectorXd>{"q", q}, {v, vel}, {a, acc}}) {
+      box += (box.size() > 1 ? ", " : "") + std::string("\"") + key + "\": [";
+      for (int i = 0; i < x.size(); ++i)
+        box += (i ? ", " : "") + std::string("[") + nhdyn::io::format_number(x(i) - 1e-3) + ", " + nhdyn::io::format_number(x(i) + 1e-3) + "]";
+      box += "]";
+    }
+    const auto b = run_tool("bound --model " + spec + " --terms all", box + "}\n");
+    REQUIRE(b.status == 0);
+    const json T = json::parse(b.lines[0])["tau"];
+    for (int i = 0; i < tau.size(); ++i) {
+      CHECK(T[std::size_t(i)][0].get<double>() <= tau(i));
+      CHECK(tau(i) <= T[std::size_t(i)][1].get<double>());
+    }
+  }
 }

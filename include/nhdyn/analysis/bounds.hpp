@@ -11,6 +11,8 @@
 ///
 /// - `enclose(f, box, k)`: any f from a vector of intervals to a vector of intervals.
 /// - `torque_bounds(chain, c, Q, H, HD, k)`: τ over q ∈ Q, η ∈ H, η̇ ∈ HD (nonholonomic).
+///   Each bound takes, after k, rne_options and the joints' friction (friction(model),
+///   dynamics/terms.hpp: the terms it includes; none by default).
 /// - `torque_bounds(chain, Q, QD, QDD, k)`: v = rne over a holonomic box.
 /// - `eta_dot_bounds(chain, c, Q, H, TAU, k)`: η̇ of the constrained forward dynamics.
 /// - `paper5_torque_bounds(P, Q, H, HD, k)`: τ over paper5's parameter box P as well.
@@ -21,10 +23,12 @@
 /// naming the output entry, e.g. "eta_dot[2]: the interval enclosure is unbounded over this
 /// box (…)"; a malformed box (lo > hi, NaN) throws input_error naming the entry.
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include "../constraints/forward_dynamics.hpp"
 #include "../constraints/stages.hpp"
+#include "../dynamics/friction.hpp"
 #include "../dynamics/rne.hpp"
 #include "../robots/presets.hpp"
 #include "../scalar/interval.hpp"
@@ -114,7 +118,8 @@ template <int N, class Model, class C, int M>
   requires(std::is_same_v<Model, chain<typename Model::scalar_type, N>> ||
            std::is_same_v<Model, tree<typename Model::scalar_type>>)
 vecN<interval, M> torque_bounds(const Model& ch, const C& c, const box<N>& Q, const box<M>& H,
-                                const box<M>& HD, int split = 0, rne_options o = {}) {
+                                const box<M>& HD, int split = 0, rne_options o = {},
+                                const std::optional<friction_fn>& friction = std::nullopt) {
   const int n = c.dof(), m = c.m();
   detail::check_size(Q, n, "q");
   detail::check_size(H, m, "eta");
@@ -123,11 +128,11 @@ vecN<interval, M> torque_bounds(const Model& ch, const C& c, const box<N>& Q, co
   check_box(H, "eta");
   check_box(HD, "eta_dot");
   constexpr int Z = (N == dynamic || M == dynamic) ? dynamic : N + 2 * M;
-  const auto id = inverse_dynamics(ch, c, o);
-  const auto f = [&](const box<Z>& z) {
-    return vecN<interval, M>(id(z.head(n), z.segment(n, m), z.tail(m)));
+  const auto bound = [&](const auto& id) {
+    const auto f = [&](const box<Z>& z) { return vecN<interval, M>(id(z.head(n), z.segment(n, m), z.tail(m))); };
+    return detail::bounded([&] { return enclose(f, detail::stack<interval, Z>(Q, H, HD), split); }, "tau");
   };
-  return detail::bounded([&] { return enclose(f, detail::stack<interval, Z>(Q, H, HD), split); }, "tau");
+  return friction ? bound(inverse_dynamics(ch, c, o, *friction)) : bound(inverse_dynamics(ch, c, o));
 }
 
 /// Enclosure of the holonomic v = rne(q, q̇, q̈) over q ∈ Q, q̇ ∈ QD, q̈ ∈ QDD (a chain, or a
@@ -136,7 +141,8 @@ template <int N, class Model>
   requires(std::is_same_v<Model, chain<typename Model::scalar_type, N>> ||
            std::is_same_v<Model, tree<typename Model::scalar_type>>)
 vecN<interval, N> torque_bounds(const Model& ch, const box<N>& Q, const box<N>& QD, const box<N>& QDD,
-                                int split = 0, rne_options o = {}) {
+                                int split = 0, rne_options o = {},
+                                const std::optional<friction_fn>& friction = std::nullopt) {
   const int n = ch.dof();
   detail::check_size(Q, n, "q");
   detail::check_size(QD, n, "qd");
@@ -145,9 +151,11 @@ vecN<interval, N> torque_bounds(const Model& ch, const box<N>& Q, const box<N>& 
   check_box(QD, "qd");
   check_box(QDD, "qdd");
   constexpr int Z = N == dynamic ? dynamic : 3 * N;
-  const auto id = rne(ch, o);
-  const auto f = [&](const box<Z>& z) { return vecN<interval, N>(id(z.head(n), z.segment(n, n), z.tail(n))); };
-  return detail::bounded([&] { return enclose(f, detail::stack<interval, Z>(Q, QD, QDD), split); }, "tau");
+  const auto bound = [&](const auto& id) {
+    const auto f = [&](const box<Z>& z) { return vecN<interval, N>(id(z.head(n), z.segment(n, n), z.tail(n))); };
+    return detail::bounded([&] { return enclose(f, detail::stack<interval, Z>(Q, QD, QDD), split); }, "tau");
+  };
+  return friction ? bound(rne(ch, o) + *friction) : bound(rne(ch, o));
 }
 
 /// Enclosure of η̇ = M_η⁻¹(SᵀEτ − h_η) over q ∈ Q, η ∈ H, τ ∈ TAU (p actuators; a chain, or a
@@ -156,7 +164,8 @@ template <int N, class Model, class C, int M, int P>
   requires(std::is_same_v<Model, chain<typename Model::scalar_type, N>> ||
            std::is_same_v<Model, tree<typename Model::scalar_type>>)
 vecN<interval, M> eta_dot_bounds(const Model& ch, const C& c, const box<N>& Q, const box<M>& H,
-                                 const box<P>& TAU, int split = 0, rne_options o = {}) {
+                                 const box<P>& TAU, int split = 0, rne_options o = {},
+                                 const std::optional<friction_fn>& friction = std::nullopt) {
   const int n = c.dof(), m = c.m(), p = actuator_count(c);
   detail::check_size(Q, n, "q");
   detail::check_size(H, m, "eta");
@@ -165,7 +174,7 @@ vecN<interval, M> eta_dot_bounds(const Model& ch, const C& c, const box<N>& Q, c
   check_box(H, "eta");
   check_box(TAU, "tau");
   constexpr int Z = (N == dynamic || M == dynamic || P == dynamic) ? dynamic : N + M + P;
-  const auto fd = nh_forward_dynamics(ch, c, o);
+  const auto fd = friction ? nh_forward_dynamics(ch, c, o).with(*friction) : nh_forward_dynamics(ch, c, o);
   const auto f = [&](const box<Z>& z) {
     return vecN<interval, M>(fd(z.head(n), z.segment(n, m), z.tail(p)));
   };

@@ -13,7 +13,8 @@
 /// - `linearize_forward_dynamics(chain, c, q, η, τ)`: ẋ = f(x, u) with x = (q, η),
 ///   f = (S(q)η, η̇(q, η, τ)), u = τ → A = ∂f/∂x, B = ∂f/∂u (from ∂τ/∂ζ by the implicit
 ///   function theorem); `forward_dynamics_linearizer(chain, c)` built once. For a holonomic chain,
-///   `linearize_forward_dynamics(chain, q, q̇, τ)`: x = (q, q̇), f = (q̇, q̈).
+///   `linearize_forward_dynamics(chain, q, q̇, τ)`: x = (q, q̇), f = (q̇, q̈). Both take, after
+///   the state, rne_options and the joints' friction (friction(model), dynamics/terms.hpp).
 /// - Parameter sensitivities: build the model from dual parameters inside f, e.g.
 ///       jacobian([&](const auto& p) {
 ///         using D = typename std::decay_t<decltype(p)>::Scalar;
@@ -27,6 +28,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <limits>
+#include <optional>
 #include <type_traits>
 #include <vector>
 
@@ -363,8 +365,16 @@ void redundant_eta_rows(const C& c, const vecN<T, dynamic>& q, const JQ& Jq, con
 template <class S, int N, class C, class Model = chain<S, N>>
 class forward_dynamics_linearizer {
  public:
-  forward_dynamics_linearizer(const Model& ch, const C& c, rne_options o = {})
-      : fd_(nh_forward_dynamics(ch, c, o)), id_(ch, c, o), id_tau_(inverse_dynamics(ch, c, o)), c_(c) {}
+  /// `friction`: the joints' friction in the forward dynamics (fd.with(friction), dynamics/
+  /// terms.hpp); then every column of ∂(Sη, η̇)/∂(q, η, τ) is taken by duals of the forward
+  /// dynamics itself (the inverse-dynamics route below has no friction).
+  forward_dynamics_linearizer(const Model& ch, const C& c, rne_options o = {},
+                              const std::optional<friction_fn>& friction = std::nullopt)
+      : fd_(friction ? nh_forward_dynamics(ch, c, o).with(*friction) : nh_forward_dynamics(ch, c, o)),
+        id_(ch, c, o),
+        id_tau_(inverse_dynamics(ch, c, o)),
+        c_(c),
+        friction_(friction.has_value()) {}
 
   template <class Q, class E, class TAU>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
@@ -376,6 +386,24 @@ class forward_dynamics_linearizer {
     detail::check_size(eta, m, "eta");
     detail::check_size(tau, p, "tau");
     using T = typename Q::Scalar;
+    if (friction_) {  // f(z) = (S(q) η, η̇(q, η, τ)), z = (q, η, τ), by duals
+      vecN<T, dynamic> z(n + m + p);
+      z << q.template cast<T>(), eta.template cast<T>(), tau.template cast<T>();
+      const auto f = [&](const auto& x) {
+        using D = typename std::decay_t<decltype(x)>::Scalar;
+        const vecN<D, N> qz = x.head(n);
+        const vecN<D, M> ez = x.segment(n, m);
+        const vecN<D, P> tz = x.tail(p);
+        vecN<D, dynamic> xdot(n + m);
+        xdot << vecN<D, N>(apply_S(c_, qz, ez)), vecN<D, M>(fd_(qz, ez, tz));
+        return xdot;
+      };
+      const auto J = jacobian(f, z);
+      state_space<T, NX, P> out;
+      out.A = J.leftCols(n + m);
+      out.B = J.rightCols(p);
+      return out;
+    }
     const vecN<T, N> qt = q.template cast<T>();
     const vecN<T, M> et = eta.template cast<T>();
     const vecN<T, M> eta_dot = fd_(qt, et, tau.template cast<T>());
@@ -406,11 +434,18 @@ class forward_dynamics_linearizer {
   inverse_dynamics_linearizer<S, N, C, Model> id_;
   decltype(inverse_dynamics(std::declval<const Model&>(), std::declval<const C&>())) id_tau_;
   C c_;
+  bool friction_;
 };
 template <class S, int N, class C>
 forward_dynamics_linearizer(const chain<S, N>&, const C&, rne_options = {}) -> forward_dynamics_linearizer<S, N, C>;
 template <class S, class C>
 forward_dynamics_linearizer(const tree<S>&, const C&, rne_options = {})
+    -> forward_dynamics_linearizer<S, dynamic, C, tree<S>>;
+template <class S, int N, class C>
+forward_dynamics_linearizer(const chain<S, N>&, const C&, rne_options, const std::optional<friction_fn>&)
+    -> forward_dynamics_linearizer<S, N, C>;
+template <class S, class C>
+forward_dynamics_linearizer(const tree<S>&, const C&, rne_options, const std::optional<friction_fn>&)
     -> forward_dynamics_linearizer<S, dynamic, C, tree<S>>;
 
 /// The same for one (q, η, τ) (builds the linearizer for this one call; keep a
@@ -418,15 +453,15 @@ forward_dynamics_linearizer(const tree<S>&, const C&, rne_options = {})
 template <class S, int N, class C, class Q, class E, class TAU>
 auto linearize_forward_dynamics(const chain<S, N>& ch, const C& c, const Eigen::MatrixBase<Q>& q,
                                 const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
-                                rne_options o = {}) {
-  return forward_dynamics_linearizer<S, N, C>(ch, c, o)(q, eta, tau);
+                                rne_options o = {}, const std::optional<friction_fn>& friction = std::nullopt) {
+  return forward_dynamics_linearizer<S, N, C>(ch, c, o, friction)(q, eta, tau);
 }
 /// The same on a tree.
 template <class S, class C, class Q, class E, class TAU>
 auto linearize_forward_dynamics(const tree<S>& t, const C& c, const Eigen::MatrixBase<Q>& q,
                                 const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
-                                rne_options o = {}) {
-  return forward_dynamics_linearizer(t, c, o)(q, eta, tau);
+                                rne_options o = {}, const std::optional<friction_fn>& friction = std::nullopt) {
+  return forward_dynamics_linearizer<S, dynamic, C, tree<S>>(t, c, o, friction)(q, eta, tau);
 }
 
 /// x = (q, q̇), f = (q̇, q̈), u = τ for a holonomic chain, or a tree (N = dynamic).
@@ -435,14 +470,14 @@ template <class Model, class Q, class QD, class TAU, int N = Model::size_at_comp
            std::is_same_v<Model, tree<typename Model::scalar_type>>)
 auto linearize_forward_dynamics(const Model& ch, const Eigen::MatrixBase<Q>& q,
                                 const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
-                                rne_options o = {}) {
+                                rne_options o = {}, const std::optional<friction_fn>& friction = std::nullopt) {
   constexpr int Z = N == dynamic ? dynamic : 3 * N;
   constexpr int NX = N == dynamic ? dynamic : 2 * N;
   const int n = ch.dof();
   detail::check_size(q, n, "q");
   detail::check_size(qd, n, "qd");
   detail::check_size(tau, n, "tau");
-  const auto fd = forward_dynamics(ch, o);
+  const auto fd = friction ? forward_dynamics(ch, o).with(*friction) : forward_dynamics(ch, o);
   const auto f = [&](const auto& z) {
     using D = typename std::decay_t<decltype(z)>::Scalar;
     vecN<D, NX> xdot(2 * n);

@@ -7,6 +7,11 @@
 /// and the state derivative (q̇, η̇) = (S η, η̇) for integrators. M_η is built either from a
 /// composite-rigid-body pass projected by S (default: measured faster, docs/performance.md)
 /// or from m calls of rne with gravity and velocity terms off (q̈ = S e_j).
+/// `fd.with(friction(model))` adds the joints' friction to the bias:
+/// h_η = Sᵀ(rne(q, Sη, Ṡη) + τ_f(Sη)) (dynamics/terms.hpp).
+#include <optional>
+
+#include "../dynamics/friction.hpp"
 #include "../dynamics/mass_matrix.hpp"
 #include "stages.hpp"
 
@@ -32,6 +37,17 @@ class nh_forward_dynamics_fn : public stage_tag {
                         std::to_string(ch.dof()));
   }
   const C& constraint() const { return c_; }
+
+  /// The same forward dynamics with the joints' friction τ_f(q̇) in the bias:
+  /// M_η η̇ = SᵀE τ − Sᵀ(rne(q, Sη, Ṡη) + τ_f(Sη)) (τ_f: friction(model), dynamics/friction.hpp).
+  nh_forward_dynamics_fn with(friction_fn f) const {
+    if (f.dof() != c_.dof())
+      throw model_error("nh_forward_dynamics: the friction is of " + std::to_string(f.dof()) + " joints, the model has " +
+                        std::to_string(c_.dof()));
+    auto r = *this;
+    r.friction_ = std::move(f);
+    return r;
+  }
 
   /// M_η(q) = Sᵀ M S (m×m).
   template <class Q>
@@ -139,6 +155,7 @@ class nh_forward_dynamics_fn : public stage_tag {
       u = (Sq.transpose() * Sq).template cast<T>() * tau.template cast<T>();
     }
     if (Qx) u += apply_St(c_, q, *Qx).template cast<T>();
+    if (friction_) u -= apply_St(c_, q, (*friction_)(apply_S(c_, q, eta))).template cast<T>();
     const auto f = ldlt_factor<T, M>(reduced_inertia(q), "the reduced inertia M_η = SᵀMS");
     vecN<T, M> eta_dot = f.solve(u - h.template cast<T>());
     detail::check_overflow(eta_dot, "nh_forward_dynamics");
@@ -150,6 +167,7 @@ class nh_forward_dynamics_fn : public stage_tag {
   rne_type inertia_rne_;
   mass_matrix_type M_;
   reduced_inertia_method method_;
+  std::optional<friction_fn> friction_;
 };
 
 template <class S, int N, pfaffian_constraint C>

@@ -14,7 +14,10 @@
 /// vectors (detail::scratch_inverse_dynamics). The numbers are the same.)
 ///
 /// and the constraint forces λ = (A Aᵀ)⁻¹ A (v − E τ), which do no work (q̇ᵀAᵀλ = 0).
+/// `inverse_dynamics(model, c, o, friction(model))` puts rne + friction in rne's place
+/// (the joints' friction, dynamics/terms.hpp).
 #include "../detail/ldlt.hpp"
+#include "../dynamics/friction.hpp"
 #include "../dynamics/rne.hpp"
 #include "../dynamics/tree.hpp"
 #include "constraint.hpp"
@@ -263,14 +266,20 @@ void check_constraint_fits(const chain<S, N>& ch, const C& c) {
     throw model_error("model '" + ch.name() + "': the constraint is over " + std::to_string(c.dof()) +
                       " joints, the chain has " + std::to_string(ch.dof()));
 }
-/// out ∘ rne ∘ lift, with a resize between lift and rne only where the sizes differ.
-template <class S, int N, class C, class Out>
-auto nh_pipeline(const chain<S, N>& ch, const C& c, rne_options o, Out out) {
+/// out ∘ dyn ∘ lift, with a resize between lift and dyn only where the sizes differ; dyn is
+/// rne(ch, o) or a stage in its place (rne + friction).
+template <class S, int N, class C, class Dyn, class Out>
+auto nh_pipeline_with(const chain<S, N>& ch, const C& c, Dyn dyn, Out out) {
   check_constraint_fits(ch, c);
   if constexpr (C::n_at_compile_time == N)
-    return compose(std::move(out), rne(ch, o), lift(c));
+    return compose(std::move(out), std::move(dyn), lift(c));
   else
-    return compose(std::move(out), rne(ch, o), resize_fn<N>{}, lift(c));
+    return compose(std::move(out), std::move(dyn), resize_fn<N>{}, lift(c));
+}
+/// out ∘ rne ∘ lift.
+template <class S, int N, class C, class Out>
+auto nh_pipeline(const chain<S, N>& ch, const C& c, rne_options o, Out out) {
+  return nh_pipeline_with(ch, c, rne(ch, o), std::move(out));
 }
 
 }  // namespace detail
@@ -283,16 +292,22 @@ auto inverse_dynamics_with_forces(const chain<S, N>& ch, const C& c, rne_options
 }
 
 namespace detail {
-/// out ∘ rne ∘ lift on a tree (run-time sized; a compile-time-sized constraint's ξ resized).
-template <class S, class C, class Out>
-auto nh_tree_pipeline(const tree<S>& t, const C& c, rne_options o, Out out) {
+/// out ∘ dyn ∘ lift on a tree (run-time sized; a compile-time-sized constraint's ξ resized);
+/// dyn is rne(t, o) or a stage in its place.
+template <class S, class C, class Dyn, class Out>
+auto nh_pipeline_with(const tree<S>& t, const C& c, Dyn dyn, Out out) {
   if (c.dof() != t.dof())
     throw model_error("model '" + t.name() + "': the constraint is over " + std::to_string(c.dof()) +
                       " joints, the tree has " + std::to_string(t.dof()));
   if constexpr (C::n_at_compile_time == dynamic)
-    return compose(std::move(out), rne(t, o), lift(c));
+    return compose(std::move(out), std::move(dyn), lift(c));
   else
-    return compose(std::move(out), rne(t, o), resize_fn<dynamic>{}, lift(c));
+    return compose(std::move(out), std::move(dyn), resize_fn<dynamic>{}, lift(c));
+}
+/// out ∘ rne ∘ lift on a tree.
+template <class S, class C, class Out>
+auto nh_tree_pipeline(const tree<S>& t, const C& c, rne_options o, Out out) {
+  return nh_pipeline_with(t, c, rne(t, o), std::move(out));
 }
 }  // namespace detail
 
@@ -306,6 +321,22 @@ auto inverse_dynamics(const tree<S>& t, const C& c, rne_options o = {}) {
 template <class S, pfaffian_constraint C>
 auto inverse_dynamics_with_forces(const tree<S>& t, const C& c, rne_options o = {}) {
   return detail::nh_tree_pipeline(t, c, o, constraint_forces(c));
+}
+
+/// With the joints' friction τ_f(q̇) (dynamics/friction.hpp, dynamics/terms.hpp):
+/// project ∘ (rne + friction) ∘ lift, on a chain or a tree.
+template <class Model, pfaffian_constraint C>
+  requires(std::is_same_v<Model, tree<typename Model::scalar_type>> ||
+           std::is_same_v<Model, chain<typename Model::scalar_type, Model::size_at_compile_time>>)
+auto inverse_dynamics(const Model& m, const C& c, rne_options o, friction_fn f) {
+  return detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), project(c));
+}
+/// As inverse_dynamics with friction, returning (τ, λ).
+template <class Model, pfaffian_constraint C>
+  requires(std::is_same_v<Model, tree<typename Model::scalar_type>> ||
+           std::is_same_v<Model, chain<typename Model::scalar_type, Model::size_at_compile_time>>)
+auto inverse_dynamics_with_forces(const Model& m, const C& c, rne_options o, friction_fn f) {
+  return detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), constraint_forces(c));
 }
 
 }  // namespace nhdyn

@@ -15,12 +15,15 @@
 ///   left), the refusal stands; `fd_method::aba` asks ABA regardless.
 ///
 /// An optional last argument, external wrenches (dynamics/wrench.hpp), adds their generalized
-/// force to τ. `rne_options` drop gravity and/or the velocity terms, for both algorithms.
+/// force to τ. `rne_options` drop gravity and/or the velocity terms, for both algorithms;
+/// `fd.with(friction(model))` puts the joints' friction on the bias side,
+/// q̈ = M⁻¹(τ − h − τ_f(q̇)) (dynamics/terms.hpp: the terms a computation includes).
 #include <cmath>
 #include <optional>
 
 #include "../detail/ldlt.hpp"
 #include "aba.hpp"
+#include "friction.hpp"
 #include "mass_matrix.hpp"
 #include "tree.hpp"
 
@@ -63,6 +66,16 @@ class forward_dynamics_fn : public stage_tag {
     return condition_number(M_(q));
   }
 
+  /// The same forward dynamics with the joints' friction on the bias side:
+  /// q̈ = M⁻¹(τ − h(q, q̇) − τ_f(q̇)) (τ_f: friction(model), dynamics/friction.hpp).
+  forward_dynamics_fn with(friction_fn f) const {
+    if (f.dof() != n_)
+      throw model_error("forward_dynamics: the friction is of " + std::to_string(f.dof()) + " joints, the model has " +
+                        std::to_string(n_));
+    auto r = *this;
+    r.friction_ = std::move(f);
+    return r;
+  }
   template <class Q, class QD, class TAU>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
                   const Eigen::MatrixBase<TAU>& tau) const {
@@ -70,6 +83,26 @@ class forward_dynamics_fn : public stage_tag {
     using T = promote_t<promote_t<promote_t<S, X>, typename QD::Scalar>, typename TAU::Scalar>;
     detail::check_size(tau, n_, "tau");
     detail::check_finite(tau, "tau");
+    if (friction_) {  // τ − τ_f(q̇): what is left to accelerate the bodies
+      const vecN<T, N> net = tau.template cast<T>() - (*friction_)(qd).template cast<T>();
+      return solve<T>(q, qd, net);
+    }
+    return solve<T>(q, qd, tau);
+  }
+
+  /// With applied forces (external wrenches, dynamics/wrench.hpp): q̈ for τ + Q_ext(q).
+  template <class Q, class QD, class TAU, applied_forces F>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
+                  const F& fx) const {
+    detail::check_size(tau, n_, "tau");
+    return (*this)(q, qd, detail::plus_applied(tau, fx, q));
+  }
+
+ private:
+  /// q̈ = M⁻¹(τ − h): CRBA + LDLᵀ or ABA as the options say.
+  template <class T, class Q, class QD, class TAU>
+  vecN<T, N> solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau) const {
+    using X = typename Q::Scalar;
     if (fd_.method == fd_method::aba || (fd_.method == fd_method::automatic && n_ >= fd_.aba_from)) return by_aba<T>(q, qd, tau);
     const auto h = rne_(q, qd, vecN<X, N>::Zero(q.size()));
     const auto M = [&] {  // M in T (a dual τ makes T a dual while M(q) is not)
@@ -86,15 +119,6 @@ class forward_dynamics_fn : public stage_tag {
     return qdd;
   }
 
-  /// With applied forces (external wrenches, dynamics/wrench.hpp): q̈ for τ + Q_ext(q).
-  template <class Q, class QD, class TAU, applied_forces F>
-  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
-                  const F& fx) const {
-    detail::check_size(tau, n_, "tau");
-    return (*this)(q, qd, detail::plus_applied(tau, fx, q));
-  }
-
- private:
   template <class T, class Q, class QD, class TAU>
   vecN<T, N> by_aba(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau) const {
     using X = typename QD::Scalar;
@@ -109,6 +133,7 @@ class forward_dynamics_fn : public stage_tag {
   fd_options fd_;
   int n_;
   std::optional<aba_fn<S>> aba_;
+  std::optional<friction_fn> friction_;
 };
 
 template <class S, int N>

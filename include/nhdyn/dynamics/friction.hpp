@@ -169,6 +169,16 @@ struct sum_fn : stage_tag {
     Eigen::Matrix<T, Eigen::Dynamic, 1> out = x.template cast<T>() + y.template cast<T>();
     return out;
   }
+  /// With applied forces (dynamics/wrench.hpp): a(q, q̇, q̈, fx) + b(q, q̇, q̈).
+  template <class Q, class QD, class QDD, applied_forces F>
+  auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
+                  const F& fx) const {
+    const auto x = a(q, qd, qdd, fx);
+    const auto y = b(q, qd, qdd);
+    using T = promote_t<typename decltype(x)::Scalar, typename decltype(y)::Scalar>;
+    Eigen::Matrix<T, Eigen::Dynamic, 1> out = x.template cast<T>() + y.template cast<T>();
+    return out;
+  }
   template <class Xi>
     requires requires(const Xi& x) {
       x.q;
