@@ -231,10 +231,149 @@ def powered_castors_arm():
     return "".join(o)
 
 
+def spin_joint(name, parent, child, xyz, effort=None, velocity=None, dynamics=None):
+    """A continuous joint about the child's y axis (a wheel's axle): a `<limit>` with effort and
+    velocity only when given (a continuous joint has no position limits)."""
+    s = joint(name, "continuous", parent, child, xyz, "0 0 0", "0 1 0", dynamics=dynamics)
+    if effort is not None:  # where joint() writes a <limit>: before <dynamics>
+        at = s.find("    <dynamics") if dynamics else s.find("  </joint>")
+        s = s[:at] + f'    <limit effort="{effort}" velocity="{velocity}"/>\n' + s[at:]
+    return s
+
+
+def tiago_style():
+    r, track, rc, trail = 0.0985, 0.2022, 0.025, 0.016
+    o = header("tiago_style", "A TIAGo-style robot after PAL Robotics' tiago_description (as example-robot-data ships it):\n"
+               "     a round differential-drive base with four passive castors (a swivel and a wheel joint each), a\n"
+               "     torso lift, a pan-tilt head, a 7-joint arm and a Hey5-style five-finger hand of 36 joints\n"
+               "     (three motors, the thumb's 5, 7 per finger; independent coordinates, no mimic): 56 joints,\n"
+               "     59 with the planar base. The published joint frames and limits; masses near the published ones.")
+    o.append(link("base_footprint"))
+    o.append(joint("base_footprint_joint", "fixed", "base_footprint", "base_link", f"0 0 {r:g}"))
+    # the base's chassis, batteries, laser and cover in one round body
+    o.append(link("base_link", 32.0, "0 0 0.03", cylinder(32.0, 0.27, 0.2),
+                  visuals=[visual(cyl_shape(0.27, 0.2), "0 0 0.03", material="white")]))
+    for side, y in (("left", track), ("right", -track)):  # the drive wheels' centres on base_link's origin height
+        o.append(spin_joint(f"wheel_{side}_joint", "base_link", f"wheel_{side}_link", f"0 {y} 0", 6.0, 10.15, (0.1, 0.0)))
+        o.append(wheel_link(f"wheel_{side}_link", 1.82, r, 0.04))
+    swivel_z = -0.0335  # the swivel joints 4 cm above the castor wheels' centres, which are rc above the floor
+    for name, x, y in (("front_left", 0.1695, 0.102), ("front_right", 0.1695, -0.102),
+                       ("back_left", -0.1735, 0.102), ("back_right", -0.1735, -0.102)):
+        o.append(joint(f"caster_{name}_1_joint", "continuous", "base_link", f"caster_{name}_1_link",
+                       f"{x} {y} {swivel_z}", "0 0 0", "0 0 1"))
+        o.append(link(f"caster_{name}_1_link", 0.1, f"{-trail / 2:g} 0 -0.02", box(0.1, 0.035, 0.03, 0.05),
+                      visuals=[visual(box_shape(0.035, 0.03, 0.05), f"{-trail / 2:g} 0 -0.02", material="grey")]))
+        o.append(spin_joint(f"caster_{name}_2_joint", f"caster_{name}_1_link", f"caster_{name}_2_link",
+                            f"{-trail:g} 0 {rc - r - swivel_z:g}"))
+        o.append(wheel_link(f"caster_{name}_2_link", 0.037, rc, 0.022))
+    # the torso: a fixed lower body and column on the base, the lift sliding up inside it
+    o.append(joint("torso_fixed_joint", "fixed", "base_link", "torso_fixed_link", "-0.062 0 0.193"))
+    o.append(link("torso_fixed_link", 11.5, "0.02 0 0.14", box(11.5, 0.25, 0.3, 0.28),
+                  visuals=[visual(box_shape(0.25, 0.3, 0.28), "0.02 0 0.14", material="white")]))
+    o.append(joint("torso_fixed_column_joint", "fixed", "base_link", "torso_fixed_column_link", "-0.062 0 0.195"))
+    o.append(link("torso_fixed_column_link", 2.5, "0 0 0.43", box(2.5, 0.15, 0.15, 0.3),
+                  visuals=[visual(box_shape(0.15, 0.15, 0.3), "0 0 0.43", material="grey")]))
+    o.append(joint("torso_lift_joint", "prismatic", "torso_fixed_link", "torso_lift_link", "0 0 0.597", "0 0 0", "0 0 1",
+                   (0.0, 0.35, 2000, 0.07), (1000.0, 0.0)))
+    o.append(link("torso_lift_link", 6.9, "0.04 0 -0.17", box(6.9, 0.26, 0.3, 0.34),
+                  visuals=[visual(box_shape(0.26, 0.3, 0.34), "0.04 0 -0.17", material="white")]))
+    # the head: pan about the torso's z, tilt about the pan link's y (written as TIAGo's: rpy, then axis z)
+    o.append(joint("head_1_joint", "revolute", "torso_lift_link", "head_1_link", "0.182 0 0", "0 0 0", "0 0 1",
+                   (-1.308996939, 1.308996939, 5.197, 3.0), (0.5, 1.0)))
+    o.append(link("head_1_link", 0.62, "0 0 0.05", box(0.62, 0.08, 0.08, 0.1),
+                  visuals=[visual(box_shape(0.08, 0.08, 0.1), "0 0 0.05", material="grey")]))
+    o.append(joint("head_2_joint", "revolute", "head_1_link", "head_2_link", "0.005 0 0.098", f"{PI2} 0 0", "0 0 1",
+                   (-1.0471975512, 0.785398163397, 2.77, 3.0), (0.5, 1.0)))
+    o.append(link("head_2_link", 0.66, "0.045 0.055 0", box(0.66, 0.14, 0.12, 0.2),
+                  visuals=[visual(box_shape(0.14, 0.12, 0.2), "0.045 0.055 0", material="white")]))
+    o.append(joint("xtion_joint", "fixed", "head_2_link", "xtion_link", "0.0908 0.08 0", f"-{PI2} 0 0"))
+    o.append(link("xtion_link", 0.22, "0 0 0", box(0.22, 0.035, 0.18, 0.025),
+                  visuals=[visual(box_shape(0.035, 0.18, 0.025), material="dark")]))
+    # the arm: TIAGo's joint frames (each joint about its own z); each link a box or cylinder from its joint
+    # toward the next one
+    lim = [(0.0, 2.74889357189, 39.0, 2.7), (-1.57079632679, 1.0908307825, 39.0, 3.66),
+           (-3.53429173529, 1.57079632679, 17.86, 4.58), (-0.392699081699, 2.35619449019, 17.86, 4.58),
+           (-2.09439510239, 2.09439510239, 3.0, 1.95), (-1.41371669412, 1.41371669412, 6.6, 1.76),
+           (-2.09439510239, 2.09439510239, 6.6, 1.76)]
+    joints = [
+        ("1", "0 0 1", "0.15505 0.014 -0.151", f"0 0 -{PI2}", 2.08, "0.0625 0.01 -0.015", box(2.08, 0.155, 0.08, 0.09),
+         [visual(box_shape(0.155, 0.08, 0.09), "0.0625 0.01 -0.015", material="white")], lim[0]),
+        ("2", "0 0 1", "0.125 0.0165 -0.031", f"{PI2} 0 0", 1.79, "0.045 0 0", box(1.79, 0.12, 0.08, 0.08),
+         [visual(box_shape(0.12, 0.08, 0.08), "0.045 0 0", material="grey")], lim[1]),
+        ("3", "0 0 1", "0.0895 0 0.0015", f"-{PI2} 0 {PI2}", 2.28, "-0.01 -0.0135 -0.12", cylinder(2.28, 0.045, 0.24),
+         [visual(cyl_shape(0.045, 0.24), "-0.01 -0.0135 -0.12", material="white")], lim[2]),
+        ("4", "0 0 1", "-0.02 -0.027 -0.222", f"-{PI2} -{PI2} 0", 1.89, "-0.09 0.01 0.0135", box(1.89, 0.2, 0.08, 0.08),
+         [visual(box_shape(0.2, 0.08, 0.08), "-0.09 0.01 0.0135", material="grey")], lim[3]),
+        ("5", "0 0 1", "-0.162 0.02 0.027", f"0 -{PI2} 0", 1.07, "0 0 0.075", cylinder(1.07, 0.04, 0.15),
+         [visual(cyl_shape(0.04, 0.15), "0 0 0.075", material="white")], lim[4]),
+        ("6", "0 0 1", "0 0 0.15", f"0 -{PI2} -{PI2}", 0.29, "0 0 0", box(0.29, 0.06, 0.05, 0.05),
+         [visual(box_shape(0.06, 0.05, 0.05), material="grey")], lim[5]),
+        ("7", "0 0 1", "0 0 0", f"{PI2} 0 {PI2}", 0.06, "0 0 0.023", cylinder(0.06, 0.025, 0.046),
+         [visual(cyl_shape(0.025, 0.046), "0 0 0.023", material="dark")], lim[6]),
+    ]
+    last = chain(o, "torso_lift_link", joints, "arm_")
+    # the wrist: a tool flange and a force-torque sensor, then the palm (its x toward the fingers, along arm_7's z)
+    o.append(joint("arm_tool_joint", "fixed", last, "arm_tool_link", "0 0 0.046"))
+    o.append(link("arm_tool_link"))
+    o.append(joint("wrist_ft_joint", "fixed", "arm_tool_link", "wrist_ft_link", "0 0 0"))
+    o.append(link("wrist_ft_link", 0.2, "0 0 0.01", cylinder(0.2, 0.035, 0.02),
+                  visuals=[visual(cyl_shape(0.035, 0.02), "0 0 0.01", material="dark")]))
+    o.append(joint("wrist_palm_joint", "fixed", "wrist_ft_link", "hand_palm_link", "0 0 0.02057", f"-{PI2} -{PI2} 0"))
+    o.append(link("hand_palm_link", 0.4, "0.06 0 0", box(0.4, 0.11, 0.035, 0.085),
+                  visuals=[visual(box_shape(0.11, 0.035, 0.085), "0.06 0 0", material="dark")]))
+    hand = (0.5, 0.0)  # the published damping; no friction
+    # the three motors in the palm (thumb, index, middle-ring-little), their shafts along the palm's x
+    for name, z, (lo, hi, v) in (("thumb", 0.025, (-2.61799387799, 6.28318530718, 3.35)),
+                                 ("index", 0.0, (-3.05432619099, 6.80678408278, 3.35)),
+                                 ("mrl", -0.025, (-2.53072741539, 9.25024503557, 3.56))):
+        o.append(joint(f"hand_{name}_joint", "revolute", "hand_palm_link", f"hand_{name}_link", f"0.03 0 {z:g}",
+                       "0 0 0", "1 0 0", (lo, hi, 2.0, v), hand))
+        o.append(link(f"hand_{name}_link", 0.05, "0.02 0 0", cylinder(0.05, 0.008, 0.04), f"0 {PI2} 0",
+                      visuals=[visual(cyl_shape(0.008, 0.04), "0.02 0 0", f"0 {PI2} 0", material="grey")]))
+    flex = (0.0, 0.785398163397, 2.0, 2.0)
+    # the thumb and four fingers: an abduction joint on the palm, then n flexions, each written as TIAGo's Hey5
+    # writes it, a "virtual" joint and a "flex" joint 13 mm apart (the segments 13 mm and 9 mm long, the tip 20 mm)
+    fingers = [  # (finger, abduction origin, rpy, limits, abduction link's length and mass, virtual_1 origin, rpy, n)
+        ("thumb", "0.0901 0.0134 0.038", "0 -1.1344640138 0", (0.0, 1.57079632679, 2.0, 2.0), 0.0225, 0.014,
+         "0.0225 0.003 0", "-1.14423785761 0 0", 2),
+        ("index", "0.1265 0.0042 0.0265", f"-{PI2} -0.523598775598 0", (-0.523598775598, 0.523598775598, 2.0, 2.0),
+         0.009, 0.018, "0.009 0 0", f"{PI2} 0 0", 3),
+        ("middle", "0.1335 0.0042 0.007", f"-{PI2} 0 0", (-0.523598775598, 0.523598775598, 2.0, 2.0),
+         0.009, 0.018, "0.009 0 0", f"{PI2} 0 0", 3),
+        ("ring", "0.1265 0.0042 -0.0125", f"-{PI2} 0.261799387799 0", (-0.523598775598, 0.523598775598, 2.0, 2.0),
+         0.009, 0.018, "0.009 0 0", f"{PI2} 0 0", 3),
+        ("little", "0.1165 0.0042 -0.032", f"-{PI2} 0.523598775598 0", (-0.523598775598, 0.523598775598, 2.0, 2.0),
+         0.009, 0.018, "0.009 0 0", f"{PI2} 0 0", 3),
+    ]
+
+    def segment(name, m, length):  # a phalanx from its joint along x, 15 mm wide and 12 mm thick
+        return link(name, m, f"{length / 2:g} 0 0", box(m, length, 0.012, 0.015),
+                    visuals=[visual(box_shape(length, 0.012, 0.015), f"{length / 2:g} 0 0", material="dark")])
+
+    for finger, xyz, rpy, abd_lim, abd_len, abd_m, v1_xyz, v1_rpy, n in fingers:
+        parent = f"hand_{finger}_abd_link"
+        o.append(joint(f"hand_{finger}_abd_joint", "revolute", "hand_palm_link", parent, xyz, rpy, "0 0 1", abd_lim, hand))
+        o.append(segment(parent, abd_m, abd_len))
+        for i in range(1, n + 1):
+            virtual, flexed = f"hand_{finger}_virtual_{i}_link", f"hand_{finger}_flex_{i}_link"
+            o.append(joint(f"hand_{finger}_virtual_{i}_joint", "revolute", parent, virtual,
+                           v1_xyz if i == 1 else "0.009 0 0", v1_rpy if i == 1 else "0 0 0", "0 0 1", flex, hand))
+            o.append(segment(virtual, 0.01, 0.013))
+            o.append(joint(f"hand_{finger}_flex_{i}_joint", "revolute", virtual, flexed, "0.013 0 0", "0 0 0", "0 0 1",
+                           flex, hand))
+            o.append(segment(flexed, 0.015, 0.02) if i == n else segment(flexed, 0.009, 0.009))
+            parent = flexed
+    o.append(joint("grasping_frame_joint", "fixed", "hand_palm_link", "hand_grasping_frame", "0.13 0.02 0"))
+    o.append(link("hand_grasping_frame"))
+    o.append("</robot>\n")
+    return "".join(o)
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "examples/urdf"
     for name, text in (("mecanum_arm", mecanum_arm()), ("omni3_arm", omni3_arm()),
-                       ("castor_drive_arm", castor_drive_arm()), ("powered_castors_arm", powered_castors_arm())):
+                       ("castor_drive_arm", castor_drive_arm()), ("powered_castors_arm", powered_castors_arm()),
+                       ("tiago_style", tiago_style())):
         with open(os.path.join(out, name + ".urdf"), "w") as f:
             f.write(text)
 
