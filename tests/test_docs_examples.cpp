@@ -238,6 +238,32 @@ TEST_CASE("docs/api.md §2: an unphysical link is refused with a message naming 
   FAIL("no model_error thrown");
 }
 
+TEST_CASE("docs/api.md §3a: choosing the terms: the forward dynamics with friction invert the inverse dynamics with it") {
+  const auto puma = nhdyn::presets::puma560_motors();
+  const auto p5 = nhdyn::presets::paper5<double>();
+  const auto& robot = p5.chain;
+  const auto& c = p5.constraint;
+  // snippet
+  const auto t = nhdyn::terms::parse("gravity,velocity,armature,friction");  // any order; or "all", "none"
+  const auto model = nhdyn::with_terms(puma, t);       // puma, or without_armature(puma) when armature is out
+  const auto fr = nhdyn::friction(model, t.coulomb);   // t.coulomb: exact unless set to coulomb_law::smooth(v_s)
+  const auto id = nhdyn::rne(model, t.rne()) + fr;     // t.rne(): rne_options{gravity, velocity}
+  const auto fd = nhdyn::forward_dynamics(model, t.rne()).with(fr);  // q̈ = M⁻¹(τ − h − τ_f(q̇)): inverts id
+  const auto rob = nhdyn::with_terms(robot, t);        // a robot with a constraint c, likewise
+  const auto nh_id = nhdyn::inverse_dynamics(rob, c, t.rne(), nhdyn::friction(rob, t.coulomb));  // project ∘ (rne + τ_f) ∘ lift
+  const auto nh_fd = nhdyn::nh_forward_dynamics(rob, c, t.rne()).with(nhdyn::friction(rob, t.coulomb));
+  // end snippet
+  const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(6, -1, 1), qd = Eigen::VectorXd::LinSpaced(6, 0.5, -0.7),
+                        qdd = Eigen::VectorXd::LinSpaced(6, 1, 2);
+  CHECK(rel(fd(q, qd, id(q, qd, qdd)), qdd) < 1e-10);
+  // the friction is in: G²B + |G|Tc⁺ of joint 1 at q̇ = 0.5 (Corke's drive parameters)
+  CHECK(std::abs((id(q, qd, qdd) - nhdyn::rne(puma)(q, qd, qdd))(0) -
+                 (62.6111 * 62.6111 * 1.48e-3 * 0.5 + 62.6111 * 0.395)) < 1e-12);
+  const Eigen::Vector<double, 5> q5(0.1, -0.2, 0.3, 0.4, -0.5);
+  const Eigen::Vector4d eta(0.3, -0.1, 0.5, 0.2), eta_dot(-0.4, 0.2, 0.1, 0.3);
+  CHECK(rel(nh_fd(q5, eta, nh_id(q5, eta, eta_dot)), eta_dot) < 1e-10);
+}
+
 TEST_CASE("docs/api.md §3: rne options drop gravity and velocity terms as the closed form says") {
   const planar2 ref;
   const auto arm = nhdyn::chain<double>(

@@ -135,8 +135,8 @@ inline constexpr std::string_view terms_help =
     R"(  --terms LIST: the terms of the equations of motion to include, comma-separated:
     gravity   g(q)
     velocity  C(q, qd) qd (Coriolis and centrifugal)
-    armature  the joints' reflected rotor inertia G^2 J_m (URDF files: none; DH models: a
-              link's "armature" or "motor")
+    armature  the joints' reflected rotor inertia G^2 J_m (a DH link's "armature" or
+              "motor", a robot file's "drives"; a URDF alone has none)
     friction  the joints' viscous and Coulomb friction (a link's "friction" or "motor", a
               URDF joint's <dynamics damping friction>)
     or all, or none. Default: gravity,velocity,armature (the rigid-body terms and armature,
