@@ -1,7 +1,7 @@
 # URDF import (io/urdf.hpp) and robot files need nhdyn::urdf (urdfdom, tinyxml2); test_urdf also compares with
 # Orocos KDL's tree solver when KDL is present (the KDL tree is built from urdfdom's model in
 # the test: Debian's kdl_parser would link all of ROS).
-foreach(t test_urdf test_wheeled_base test_wheel_kinds test_robot_simulation test_derivatives)
+foreach(t test_urdf test_wheeled_base test_wheel_kinds test_robot_simulation test_derivatives test_scene_terms)
   if(TARGET ${t})
     if(TARGET nhdyn::urdf)
       target_link_libraries(${t} PRIVATE nhdyn::urdf)

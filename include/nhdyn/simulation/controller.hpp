@@ -27,12 +27,14 @@
 ///     Eigen::Vector4d tau = ctrl(q, eta, r_measured, circle(t));
 ///     // any tree and constraint, the point p on body i (1-based, as tree_kinematics):
 ///     nhdyn::rac_controller arm(tree, c, gains, q0, mask, i, p);
+#include <optional>
 #include <variant>
 
 #include <Eigen/Dense>
 
 #include "../constraints/stages.hpp"
 #include "../detail/ldlt.hpp"
+#include "../dynamics/friction.hpp"
 #include "../dynamics/tree.hpp"
 #include "../kinematics/kinematics.hpp"
 #include "../kinematics/tree.hpp"
@@ -87,6 +89,10 @@ template <class S>
 tree_kinematics<S> kinematics_of(const tree<S>& t) {
   return tree_kinematics<S>(t);
 }
+/// The controllers' inverse dynamics with the joints' friction: project ∘ (rne + τ_f) ∘ lift.
+template <class Model, class C>
+using friction_inverse_dynamics_t = decltype(inverse_dynamics(std::declval<const Model&>(), std::declval<const C&>(),
+                                                              rne_options{}, std::declval<friction_fn>()));
 }  // namespace detail
 
 /// Model: chain<S, N> (the default) or tree<S> (N = dynamic).
@@ -98,9 +104,12 @@ class rac_controller {
   /// nominal: the controller's model; posture_mask: 1 for joints the posture term holds at
   /// q_posture (paper5: joints 4 and 5), 0 elsewhere; task_body: the link or body carrying r
   /// (1…n as the kinematics number them; default the last), task_point: r on it, in its frame.
+  /// o: the terms of eq. 21's rne (gravity, velocity; dynamics/terms.hpp); friction: the
+  /// joints' friction the controller compensates (eq. 21 with rne + τ_f), none by default.
   rac_controller(const Model& nominal, C c, rac_gains g, vecN<double, N> q_posture, vecN<double, N> posture_mask,
-                 int task_body = -1, const vec3<S>& task_point = vec3<S>::Zero())
-      : c_(c), kin_(detail::kinematics_of(nominal)), id_(inverse_dynamics(nominal, c)), g_(std::move(g)),
+                 int task_body = -1, const vec3<S>& task_point = vec3<S>::Zero(), rne_options o = {},
+                 std::optional<friction_fn> friction = std::nullopt)
+      : c_(c), kin_(detail::kinematics_of(nominal)), id_(inverse_dynamics(nominal, c, o)), g_(std::move(g)),
         P_(lyapunov_P(g_.K0, g_.K1)), q_posture_(std::move(q_posture)), mask_(std::move(posture_mask)),
         link_(task_body < 0 ? nominal.dof() : task_body), point_(task_point) {
     if (!(g_.lambda >= 0) || !(g_.kN >= 0) || !(g_.kP >= 0) || !(g_.robust.epsilon >= 0) ||
@@ -114,6 +123,12 @@ class rac_controller {
                         std::to_string(n));
     if (link_ < 1 || link_ > n) throw input_error("controller: task body " + std::to_string(link_) + " is not in 1…" + std::to_string(n));
     if (!point_.allFinite()) throw input_error("controller: the task point is not finite");
+    if (friction) {
+      if (friction->dof() != n)
+        throw input_error("controller: the friction is of " + std::to_string(friction->dof()) + " joints, the model has " +
+                          std::to_string(n));
+      idf_.emplace(inverse_dynamics(nominal, c_, o, std::move(*friction)));
+    }
   }
   const Eigen::Matrix<double, 6, 6>& P() const { return P_; }
   const rac_gains& gains() const { return g_; }
@@ -153,6 +168,7 @@ class rac_controller {
     const vecN<T, N> dq = (mask_.template cast<T>().array() * (q - q_posture_.template cast<T>()).array()).matrix();
     const vecN<T, M> z = -T(g_.kN) * eta - T(g_.kP) * apply_St(c_, q, dq);
     const vecN<T, M> a = Bp * (a_r - Bdot_eta) + z - Bp * (B * z);                 // eq. 30
+    if (idf_) return vecN<T, M>((*idf_)(q, eta, a));                                // eq. 21 with friction
     return id_(q, eta, a);                                                          // eq. 21
   }
 
@@ -175,6 +191,7 @@ class rac_controller {
   C c_;
   decltype(detail::kinematics_of(std::declval<const Model&>())) kin_;
   decltype(inverse_dynamics(std::declval<const Model&>(), std::declval<const C&>())) id_;
+  std::optional<detail::friction_inverse_dynamics_t<Model, C>> idf_;  ///< with friction (then used instead of id_)
   rac_gains g_;
   Eigen::Matrix<double, 6, 6> P_;
   vecN<double, N> q_posture_, mask_;
@@ -210,13 +227,22 @@ class computed_torque_controller {
  public:
   static constexpr int M = C::m_at_compile_time;
 
-  computed_torque_controller(const Model& nominal, C c, ct_gains g)
-      : c_(c), id_(inverse_dynamics(nominal, c)), g_(g), n_(nominal.dof()) {
+  /// o: the terms of the nominal rne (gravity, velocity; dynamics/terms.hpp); friction: the
+  /// joints' friction the controller compensates (rne + τ_f), none by default.
+  computed_torque_controller(const Model& nominal, C c, ct_gains g, rne_options o = {},
+                             std::optional<friction_fn> friction = std::nullopt)
+      : c_(c), id_(inverse_dynamics(nominal, c, o)), g_(g), n_(nominal.dof()) {
     if (!(g_.kp >= 0) || !(g_.kd >= 0) || !std::isfinite(g_.kp) || !std::isfinite(g_.kd))
       throw input_error("computed-torque controller: need finite k_P, k_D ≥ 0");
     if (c_.dof() != n_)
       throw input_error("computed-torque controller: the constraint is for " + std::to_string(c_.dof()) +
                         " coordinates, the model has " + std::to_string(n_));
+    if (friction) {
+      if (friction->dof() != n_)
+        throw input_error("computed-torque controller: the friction is of " + std::to_string(friction->dof()) +
+                          " joints, the model has " + std::to_string(n_));
+      idf_.emplace(inverse_dynamics(nominal, c_, o, std::move(*friction)));
+    }
   }
   const ct_gains& gains() const { return g_; }
 
@@ -230,26 +256,31 @@ class computed_torque_controller {
     const vecN<T, N> qd = apply_S(c_, q, eta);
     const vecN<T, N> a = vecN<T, N>(ref.qdd) + T(g_.kd) * (vecN<T, N>(ref.qd) - qd) + T(g_.kp) * (vecN<T, N>(ref.q) - q);
     const vecN<T, M> rhs = apply_St(c_, q, vecN<T, N>(a - apply_Sdot(c_, q, qd, eta)));
+    const auto id = [&](const vecN<T, M>& eta_dot) -> vecN<T, M> {
+      if (idf_) return vecN<T, M>((*idf_)(q, eta, eta_dot));
+      return id_(q, eta, eta_dot);
+    };
     if constexpr (C::orthonormal_S) {
-      return id_(q, eta, rhs);
+      return id(rhs);
     } else {
       const auto Sq = c_.S(q);
       const Eigen::Matrix<T, M, M> G = Sq.transpose() * Sq;
-      return id_(q, eta, vecN<T, M>(ldlt_factor<T, M>(G, "SᵀS").solve(rhs)));
+      return id(vecN<T, M>(ldlt_factor<T, M>(G, "SᵀS").solve(rhs)));
     }
   }
 
  private:
   C c_;
   decltype(inverse_dynamics(std::declval<const Model&>(), std::declval<const C&>())) id_;
+  std::optional<detail::friction_inverse_dynamics_t<Model, C>> idf_;  ///< with friction (then used instead of id_)
   ct_gains g_;
   int n_;
 };
 
-template <class S, int N, class C>
-computed_torque_controller(const chain<S, N>&, C, ct_gains) -> computed_torque_controller<S, N, C>;
-template <class S, class C>
-computed_torque_controller(const tree<S>&, C, ct_gains) -> computed_torque_controller<S, dynamic, C, tree<S>>;
+template <class S, int N, class C, class... A>
+computed_torque_controller(const chain<S, N>&, C, ct_gains, A...) -> computed_torque_controller<S, N, C>;
+template <class S, class C, class... A>
+computed_torque_controller(const tree<S>&, C, ct_gains, A...) -> computed_torque_controller<S, dynamic, C, tree<S>>;
 
 /// Either controller behind one call (a scene picks one at run time; the closed loop is
 /// compiled once for both).

@@ -14,6 +14,9 @@
 /// body's mass (its rotational inertia scaled with it, so its centre of mass stays), on a
 /// joint's placement (the joint's origin in its parent; for a DH model d and a of that link)
 /// and on the constraint's wheel radius. A model without a constraint is holonomic (S = I).
+/// The terms of each (run_spec::plant_terms, model_terms; dynamics/terms.hpp): the plant's
+/// forward dynamics and the controller's inverse dynamics include those, and paper5 with
+/// terms other than the default runs here as a tree rather than by `simulate`.
 #include <algorithm>
 #include <cctype>
 #include <concepts>
@@ -110,7 +113,9 @@ inline io::robot_model load_scene_robot(const std::string& robot) {
 namespace detail {
 /// A scene's robot set up as trees (see the file comment): plant and nominal model, the
 /// constraint of each (none: holonomic), the task body (1-based) and point, the initial
-/// state, the posture mask and η's names. paper5 here is `as_tree` of its chains.
+/// state, the posture mask and η's names. paper5 here is `as_tree` of its chains. Each tree
+/// is as its terms want it (armature 0 when out, gravity zero when out: model_with_terms);
+/// the velocity and friction terms are the computations' (simulate_robot, scene_controller).
 struct scene_setup {
   std::string robot;
   tree<double> plant, nominal;
@@ -124,6 +129,12 @@ struct scene_setup {
 inline scene_setup setup_scene(const run_spec& s) {
   const std::string where = "scene '" + s.name + "': ";
   scene_setup out;
+  // the trees as their terms want them (after everything else read them: the constraints, frames)
+  const auto apply_terms = [&](scene_setup& o) {
+    if (!(s.plant_terms == terms{})) o.plant = model_with_terms(o.plant, s.plant_terms);
+    if (!(s.model_terms == terms{})) o.nominal = model_with_terms(o.nominal, s.model_terms);
+    return std::move(o);
+  };
   if (s.robot == "paper5") {
     detail::check_reference(s, 5);
     const differential_drive<double> c = *io::preset<double>("paper5").constraint;
@@ -134,7 +145,7 @@ inline scene_setup setup_scene(const run_spec& s) {
     out.body = 5;
     out.q0 = s.q0, out.eta0 = s.eta0, out.mask = s.posture_mask;
     out.eta_names = c.eta_names(out.plant.joint_names());
-    return out;
+    return apply_terms(out);
   }
   const io::robot_model r = load_scene_robot(s.robot);
   const int n = r.model.dof(), m = n - r.k();
@@ -167,7 +178,7 @@ inline scene_setup setup_scene(const run_spec& s) {
     if (s.plant_wheel_radius != 1 || s.model_wheel_radius != 1)
       throw input_error(where + "field '" + (s.plant_wheel_radius != 1 ? "plant" : "model") +
                         ".wheel_radius_factor': robot '" + r.name + "' has no constraint (no wheels)");
-    return out;
+    return apply_terms(out);
   }
   // The constraint of each tree (its geometry follows the link lengths), with its wheel radius.
   const auto constraint_of = [&](const tree<double>& t, double radius_factor, const std::string& who) {
@@ -191,14 +202,16 @@ inline scene_setup setup_scene(const run_spec& s) {
   };
   out.c_plant = constraint_of(out.plant, s.plant_wheel_radius, "plant");
   out.c_model = constraint_of(out.nominal, s.model_wheel_radius, "model");
-  return out;
+  return apply_terms(out);
 }
 }  // namespace detail
 
 /// One run of a scene on its robot as a tree (paper5 included) with the controller
 /// `make(nominal, c, body, point, q0, posture_mask)` returns for the nominal tree and its
 /// constraint c (`holonomic<dynamic>` for a model without one): a user's controller in a
-/// scene's set-up. Throws for a scene that cannot be set up.
+/// scene's set-up. The plant runs with its terms (run_spec::plant_terms); `nominal` has the
+/// model's armature and gravity terms applied (its velocity and friction terms are for
+/// `make` to honour: scene_controller does). Throws for a scene that cannot be set up.
 template <class Make>
 run_result simulate_scene_with(const run_spec& s, const Make& make) {
   return detail::timed([&] {  // the times include loading the robot
@@ -207,14 +220,17 @@ run_result simulate_scene_with(const run_spec& s, const Make& make) {
     const scene_reference ref(s.reference, model_kin, S.body, S.point);
     const auto run = [&](const auto& c_plant, const auto& c_model) {
       const auto ctrl = make(S.nominal, c_model, S.body, S.point, S.q0, S.mask);
-      return simulate_robot(s.name, S.plant, c_plant, S.body, S.point, ctrl, ref, S.q0, S.eta0, options_of(s), S.eta_names);
+      return simulate_robot(s.name, S.plant, c_plant, S.body, S.point, ctrl, ref, S.q0, S.eta0, options_of(s), S.eta_names,
+                            s.plant_terms);
     };
     if (!S.c_plant) return run(holonomic<dynamic>{S.plant.dof()}, holonomic<dynamic>{S.plant.dof()});
     return std::visit([&](const auto& c) { return run(c, std::get<std::decay_t<decltype(c)>>(*S.c_model)); }, *S.c_plant);
   });
 }
 
-/// The controller a scene names (controller.type) for the nominal tree and constraint c.
+/// The controller a scene names (controller.type) for the nominal tree and constraint c, with
+/// the model's velocity term (rne_options) and, when in, its friction (the nominal tree's
+/// joints' laws) from run_spec::model_terms.
 struct scene_controller {
   const run_spec& s;
   template <class C>
@@ -222,20 +238,23 @@ struct scene_controller {
                                                              const vec3<double>& point, const Eigen::VectorXd& q0,
                                                              const Eigen::VectorXd& mask) const {
     using Ctrl = any_controller<double, dynamic, C, tree<double>>;
-    if (s.controller == controller_type::task_space) return Ctrl(rac_controller(nominal, c, s.gains, q0, mask, body, point));
-    return Ctrl(computed_torque_controller(nominal, c, s.ct));
+    const rne_options o = s.model_terms.rne();
+    if (s.controller == controller_type::task_space)
+      return Ctrl(rac_controller(nominal, c, s.gains, q0, mask, body, point, o, detail::friction_with_terms(nominal, s.model_terms)));
+    return Ctrl(computed_torque_controller(nominal, c, s.ct, o, detail::friction_with_terms(nominal, s.model_terms)));
   }
 };
 
 /// One run of a scene on its robot (see the file comment): paper5 by `simulate` (DH kernels,
-/// fixed sizes), any other robot by simulate_scene_with and the scene's controller. Throws
+/// fixed sizes) when its terms are the default, any other robot (and paper5 with other terms,
+/// as a tree) by simulate_scene_with and the scene's controller. Throws
 /// for a scene that cannot be set up (unknown frame or joint, wrong sizes, a controller that
 /// does not fit its reference). A function object, as `simulate`: the closed loops (one per
 /// constraint type) are compiled only where it is called.
 struct simulate_scene_fn {
   template <std::same_as<run_spec> Spec>
   run_result operator()(const Spec& s) const {
-    if (s.robot == "paper5") return simulate(s);
+    if (s.robot == "paper5" && s.plant_terms == terms{} && s.model_terms == terms{}) return simulate(s);
     return simulate_scene_with(s, scene_controller{s});
   }
 };

@@ -6,7 +6,7 @@
 /// field 'controller.K2'"), so a typo never falls back to a default silently.
 ///
 ///     scene  = {"name", "description", "robot": "paper5" | robot file, "task": {"frame", "point"},
-///               "plant": factors, "model": factors,
+///               "plant": factors and terms, "model": factors and terms,
 ///               "controller": {...}, "reference": {...}, "initial": {"q", "eta"},
 ///               "integrator": {...}, "duration", "sampling": {...}, "noise": {...},
 ///               "output": {"step"}, "success": {"tail_from", "max_tail_error"}}
@@ -135,7 +135,38 @@ inline presets::paper5_parameters<double> read_factors(const object& o) {
   p.a5_factor = o.number("a5_factor", 1);
   return p;
 }
-constexpr std::initializer_list<const char*> factor_keys = {"mass_factor", "d3_factor", "a4_factor", "a5_factor"};
+constexpr std::initializer_list<const char*> factor_keys = {"mass_factor", "d3_factor", "a4_factor", "a5_factor",
+                                                            "terms", "smooth_coulomb"};
+/// plant/model keys for any robot but paper5.
+constexpr std::initializer_list<const char*> robot_factor_keys = {"mass_factor", "length_factor", "wheel_radius_factor",
+                                                                  "terms", "smooth_coulomb"};
+
+/// The terms (dynamics/terms.hpp) of a plant or model object: "terms" (a list of names,
+/// terms::parse; default gravity, velocity, armature) and "smooth_coulomb" (v_s > 0 of the
+/// smooth Coulomb law; only with friction in). Errors name the scene and the field.
+inline terms read_terms(const object& o) {
+  terms t{};
+  if (o.has("terms")) {
+    const std::string list = o.text("terms", "");
+    try {
+      t = terms::parse(list);
+    } catch (const input_error& e) {
+      std::string why = e.what();
+      const std::string prefix = "terms '" + list + "': ";  // the field names the list already
+      if (why.rfind(prefix, 0) == 0) why.erase(0, prefix.size());
+      throw input_error(o.where + "field '" + o.name("terms") + "': " + why);
+    }
+  }
+  if (o.has("smooth_coulomb")) {
+    const double v = o.number("smooth_coulomb", 0);
+    if (!t.friction)
+      throw input_error(o.where + "field '" + o.name("smooth_coulomb") + "': the Coulomb law it smooths needs friction in '" +
+                        o.name("terms") + "' (terms: " + t.list() + ")");
+    if (!(v > 0)) throw input_error(o.where + "field '" + o.name("smooth_coulomb") + "' must be > 0 (a velocity scale)");
+    t.coulomb = coulomb_law::smooth(v);
+  }
+  return t;
+}
 }  // namespace detail
 
 /// The shipped robot files' folder: `share/nhdyn/robots` beside the scenes' (robot names in
@@ -195,7 +226,7 @@ inline run_spec parse_run(const json& j, const std::vector<std::filesystem::path
     const auto by_name = [&](const char* k, const char* key, const char* what) {
       std::vector<std::pair<std::string, double>> out;
       if (!o.has(k)) return out;
-      const auto f = o.sub(k, {"mass_factor", "length_factor", "wheel_radius_factor"});
+      const auto f = o.sub(k, detail::robot_factor_keys);
       if (!f.has(key)) return out;
       const json& mf = f.j.at(key);
       if (!mf.is_object())
@@ -210,7 +241,7 @@ inline run_spec parse_run(const json& j, const std::vector<std::filesystem::path
     };
     const auto radius = [&](const char* k) {
       if (!o.has(k)) return 1.0;
-      const auto f = o.sub(k, {"mass_factor", "length_factor", "wheel_radius_factor"});
+      const auto f = o.sub(k, detail::robot_factor_keys);
       const double r = f.number("wheel_radius_factor", 1);
       if (!(r > 0)) throw input_error(where + "field '" + std::string(k) + ".wheel_radius_factor' must be > 0");
       return r;
@@ -222,10 +253,23 @@ inline run_spec parse_run(const json& j, const std::vector<std::filesystem::path
     s.plant_wheel_radius = radius("plant");
     s.model_wheel_radius = radius("model");
     s.plant = s.model = presets::paper5_parameters<double>{};  // not used: no paper5 factors
+    if (o.has("plant")) s.plant_terms = detail::read_terms(o.sub("plant", detail::robot_factor_keys));
+    if (o.has("model")) s.model_terms = detail::read_terms(o.sub("model", detail::robot_factor_keys));
   } else {
     if (o.has("task")) throw input_error(where + "field 'task': paper5's task point is the origin of link 5 (not settable)");
-    if (o.has("plant")) s.plant = detail::read_factors(o.sub("plant", detail::factor_keys));
-    if (o.has("model")) s.model = detail::read_factors(o.sub("model", detail::factor_keys));
+    // An object with factors gives all four (those not given: 1); one with only the terms keys
+    // keeps the default factors (the plant's paper-circle mismatch), so that choosing terms
+    // changes nothing else.
+    const auto factors_of = [&](const char* k, presets::paper5_parameters<double>& p, terms& t) {
+      if (!o.has(k)) return;
+      const auto f = o.sub(k, detail::factor_keys);
+      const bool only_terms = (f.has("terms") || f.has("smooth_coulomb")) &&
+                              !(f.has("mass_factor") || f.has("d3_factor") || f.has("a4_factor") || f.has("a5_factor"));
+      if (!only_terms) p = detail::read_factors(f);
+      t = detail::read_terms(f);
+    };
+    factors_of("plant", s.plant, s.plant_terms);
+    factors_of("model", s.model, s.model_terms);
   }
 
   const auto c = o.sub("controller", {"type", "K0", "K1", "lambda", "kN", "kP", "posture_joints", "robust", "kp", "kd"});

@@ -27,6 +27,7 @@
 #include <sstream>
 
 #include "../constraints/forward_dynamics.hpp"
+#include "../dynamics/terms.hpp"
 #include "../io/number.hpp"
 #include "../robots/presets.hpp"
 #include "controller.hpp"
@@ -81,6 +82,12 @@ struct run_spec : run_options {
   std::vector<std::pair<std::string, double>> plant_mass, model_mass;  ///< mass factors by body name
   std::vector<std::pair<std::string, double>> plant_length, model_length;  ///< joint placement factors by joint name
   double plant_wheel_radius = 1, model_wheel_radius = 1;  ///< factors on the constraint's wheel radius
+
+  // Which terms of the equations of motion the plant's forward dynamics and the controller's
+  // model include (dynamics/terms.hpp; scene fields plant.terms, model.terms, smooth_coulomb).
+  // The default is today's: gravity, velocity and armature, no friction. Any robot; paper5
+  // with other terms runs as a tree (simulate_scene), not by `simulate`.
+  terms plant_terms{}, model_terms{};
 
   // Where the run came from in a study (scene.hpp), for summary.json:
   std::optional<std::uint64_t> run_seed;  ///< a Monte Carlo run's seed (replays it alone)
@@ -317,6 +324,20 @@ run_result simulate_closed_loop(const std::string& name, const C& c, const FD& f
 }
 
 namespace detail {
+/// The model as terms t want it: armature dropped when out (with_terms), gravity zero when
+/// out (velocity and friction are the computation's: rne_options, friction_fn).
+template <class Model>
+Model model_with_terms(const Model& m, const terms& t) {
+  if (t.gravity) return with_terms(m, t);
+  return with_terms(m, t).with_gravity(vec3<typename Model::scalar_type>::Zero());
+}
+/// The model's friction (its joints' laws, t.coulomb) when t has friction in, else none.
+template <class Model>
+std::optional<friction_fn> friction_with_terms(const Model& m, const terms& t) {
+  if (!t.friction) return std::nullopt;
+  return friction(m, t.coulomb);
+}
+
 /// Throws input_error unless the scene's reference suits its controller and its robot's n joints.
 inline void check_reference(const run_spec& s, int n) {
   const std::string where = "scene '" + s.name + "': ";
@@ -352,6 +373,10 @@ struct simulate_fn {
       if (s.robot != "paper5")
         throw input_error("scene '" + s.name + "': robot '" + s.robot +
                           "' is not paper5: simulate_scene (simulation/robot_scene.hpp, needs URDF support) runs it");
+      if (!(s.plant_terms == terms{}) || !(s.model_terms == terms{}))
+        throw input_error("scene '" + s.name + "': fields 'plant.terms', 'model.terms': paper5 with terms other than " +
+                          "the default (gravity,velocity,armature) runs as a tree: simulate_scene " +
+                          "(simulation/robot_scene.hpp, needs URDF support) runs it");
       detail::check_reference(s, 5);
       const auto plant = presets::paper5<double>(s.plant);
       const auto nominal = presets::paper5<double>(s.model);
@@ -376,14 +401,24 @@ inline constexpr simulate_fn simulate{};
 /// function object) and any reference: r is the point `point` of body `body` (1-based,
 /// tree_kinematics' numbering; tree::find_frame turns a frame name into one) on the plant.
 /// Everything the controller knows (its model, constraint, gains) is inside it: plant–model
-/// mismatch is a controller built on another tree or constraint.
+/// mismatch is a controller built on another tree or constraint. `plant_terms`: the terms of
+/// the plant's forward dynamics (dynamics/terms.hpp; default gravity, velocity, armature):
+/// armature out drops the joints' armature, gravity and velocity out drop g(q) and C(q, q̇)q̇
+/// (rne_options), friction in adds the joints' friction laws (fd.with(friction(plant))).
 template <class C, class Controller, class Reference>
 run_result simulate_robot(const std::string& name, const tree<double>& plant, const C& c, int body,
                           const vec3<double>& point, const Controller& controller, const Reference& reference,
                           const Eigen::VectorXd& q0, const Eigen::VectorXd& eta0, const run_options& o,
-                          const std::vector<std::string>& eta_names) {
+                          const std::vector<std::string>& eta_names, const terms& plant_terms = {}) {
   const tree_kinematics<double> plant_kin(plant);
-  const auto fd = nh_forward_dynamics(plant, c);
+  std::optional<tree<double>> with_t;  // the plant as its terms want it (the plant itself by default)
+  if (!(plant_terms == terms{})) with_t = detail::model_with_terms(plant, plant_terms);
+  const tree<double>& dyn = with_t ? *with_t : plant;
+  const auto fd = [&] {
+    auto f = nh_forward_dynamics(dyn, c, plant_terms.rne());
+    if (plant_terms.friction) return f.with(friction(dyn, plant_terms.coulomb));
+    return f;
+  }();
   const auto task = [&](const auto& q) { return plant_kin.point(q, body, point); };
   const auto joints = plant.joint_names();
   return simulate_closed_loop<dynamic, dynamic>(name, c, fd, task, controller, reference, q0, eta0, o,
@@ -392,17 +427,26 @@ run_result simulate_robot(const std::string& name, const tree<double>& plant, co
 
 /// The same with the robust task-space controller (controller.hpp) on `nominal` (same
 /// constraint), driving that point along `reference`; the posture term holds the joints whose
-/// `posture_mask` entry is 1 at q0.
+/// `posture_mask` entry is 1 at q0. `plant_terms` as above; `model_terms`: the terms of the
+/// controller's inverse dynamics on `nominal` (armature, gravity, velocity; friction in: the
+/// controller compensates the nominal joints' friction laws).
 template <class C, class Reference = circle_reference>
 run_result simulate_robot(const std::string& name, const tree<double>& plant, const tree<double>& nominal, const C& c,
                           int body, const vec3<double>& point, const Reference& reference, const rac_gains& gains,
                           const Eigen::VectorXd& q0, const Eigen::VectorXd& eta0, const Eigen::VectorXd& posture_mask,
-                          const run_options& o, const std::vector<std::string>& eta_names) {
+                          const run_options& o, const std::vector<std::string>& eta_names, const terms& plant_terms = {},
+                          const terms& model_terms = {}) {
   if (plant.dof() != nominal.dof())
     throw input_error("scene '" + name + "': plant and model have " + std::to_string(plant.dof()) + " and " +
                       std::to_string(nominal.dof()) + " joints");
-  const rac_controller ctrl(nominal, c, gains, q0, posture_mask, body, point);
-  return simulate_robot(name, plant, c, body, point, ctrl, reference, q0, eta0, o, eta_names);
+  if (model_terms == terms{}) {
+    const rac_controller ctrl(nominal, c, gains, q0, posture_mask, body, point);
+    return simulate_robot(name, plant, c, body, point, ctrl, reference, q0, eta0, o, eta_names, plant_terms);
+  }
+  const tree<double> model = detail::model_with_terms(nominal, model_terms);
+  const rac_controller ctrl(model, c, gains, q0, posture_mask, body, point, model_terms.rne(),
+                            detail::friction_with_terms(model, model_terms));
+  return simulate_robot(name, plant, c, body, point, ctrl, reference, q0, eta0, o, eta_names, plant_terms);
 }
 
 /// Shortest round-trip decimal form of x (std::to_chars): parsing it gives x back exactly.
