@@ -32,4 +32,7 @@ add_executable(nhdyn_tool ${CMAKE_CURRENT_SOURCE_DIR}/nhdyn_tool/main.cpp)
 set_target_properties(nhdyn_tool PROPERTIES OUTPUT_NAME nhdyn RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/${CMAKE_INSTALL_BINDIR})
 target_link_libraries(nhdyn_tool PRIVATE nhdyn_tool_objects nhdyn_project_options)
 add_dependencies(nhdyn_tool nhdyn_data)
+if(TARGET nhdyn_viewer)  # nhdyn view's page template
+  add_dependencies(nhdyn_tool nhdyn_viewer)
+endif()
 install(TARGETS nhdyn_tool RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})

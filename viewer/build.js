@@ -4,14 +4,15 @@
 //   dist/template.html     a complete HTML page, the CSS and the bundle inlined, and one line
 //                          `/*NHDYN_DATA*/` that the writer (nhdyn view, tools/make_page.py)
 //                          replaces by `window.NHDYN_DATA = {...};`
-// Usage: node build.js [--no-minify]
+// Usage: node build.js [--no-minify] [--out DIR]   (DIR: where both go; default dist/ here)
 'use strict';
 const fs = require('fs');
 const path = require('path');
 const esbuild = require('esbuild');
 
 const here = __dirname;
-const dist = path.join(here, 'dist');
+const outAt = process.argv.indexOf('--out');
+const dist = outAt > 0 && process.argv[outAt + 1] ? path.resolve(process.argv[outAt + 1]) : path.join(here, 'dist');
 const minify = !process.argv.includes('--no-minify');
 const PLACEHOLDER = '/*NHDYN_DATA*/';
 
@@ -54,9 +55,9 @@ async function main() {
     const key = m ? m[1] : 'src';
     byPackage[key] = (byPackage[key] || 0) + info.bytesInOutput;
   }
-  console.log(`dist/viewer.bundle.js  ${kb(Buffer.byteLength(js))} (${minify ? 'minified' : 'not minified'}; ` +
+  console.log(`${path.join(dist, 'viewer.bundle.js')}  ${kb(Buffer.byteLength(js))} (${minify ? 'minified' : 'not minified'}; ` +
     Object.entries(byPackage).map(([k, v]) => `${k} ${kb(v)}`).join(', ') + ')');
-  console.log(`dist/template.html     ${kb(Buffer.byteLength(html))}`);
+  console.log(`${path.join(dist, 'template.html')}  ${kb(Buffer.byteLength(html))}`);
 }
 
 main().catch((e) => { console.error('build.js: ' + (e && e.stack || e)); process.exit(1); });

@@ -12,7 +12,8 @@
   X(fd)                        \
   X(linearize)                 \
   X(bound)                     \
-  X(simulate)
+  X(simulate)                  \
+  X(view)
 
 #include <iostream>
 #include <nhdyn/version.hpp>

@@ -33,7 +33,7 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn simulate SCENE... --out DIR [--threads N] [--no-plots]
+constexpr std::string_view usage = R"(nhdyn simulate SCENE... --out DIR [--threads N] [--no-plots] [--html]
   Runs each SCENE (a JSON file, or the name of a shipped scene: paper-circle,
   paper-factorial, paper-noise, paper = all three, mobile-manipulator-circle,
   mobile-manipulator-monte-carlo, mecanum-sideways-circle, puma560-line,
@@ -45,7 +45,7 @@ constexpr std::string_view usage = R"(nhdyn simulate SCENE... --out DIR [--threa
                         q_<joint>..., eta_<name>..., tau_<name>... by its names); tau is the torque applied
                         (the held value under zero-order hold), r the plant's true position,
                         err = |r_d - r|; numbers round-trip exact
-    DIR/summary.json    {"runs": [{name, success, max_tail_error, steps, failure, wall_time_s,
+    DIR/summary.json    {"runs": [{name, robot, success, max_tail_error, steps, failure, wall_time_s,
                         cpu_time_s, peak_tau, seed (Monte Carlo), factors (studies), rank, host}],
                         "aggregate": {count, succeeded, success_rate, max_tail_error and
                         peak_tau percentiles (min, p5, p50, p95, max), wall_time_s, cpu_time_s}}
@@ -55,6 +55,9 @@ constexpr std::string_view usage = R"(nhdyn simulate SCENE... --out DIR [--threa
                         5-95 % and the median, over the runs that reached the end (a failing
                         run stops early), and 40 runs' paths, from
                         DIR/<group>-bands.csv: t, then <column>_min,_p5,_p50,_p95,_max)
+    DIR/view.html       with --html: the runs in a web page (nhdyn view DIR: the robot moving,
+                        its trace, the task path, tau and the error; when every run has the
+                        same robot, at most 40 runs)
   A study's runs go in parallel on --threads workers (default: all cores), with a progress
   bar and an ETA when stderr is a terminal. Under MPI (mpirun -n N nhdyn simulate ...) the
   runs are handed out one at a time to N processes on any machines (rank 0 runs them too),
@@ -425,6 +428,8 @@ int run(const std::vector<std::string>& args) {
   app.add_option("--out", out)->required();
   add_integer_option(app, "--threads", threads, 0, 4096);
   app.add_flag("--no-plots", no_plots);
+  bool html = false;
+  app.add_flag("--html", html);
   if (!parse_command_line(app, args, usage)) return 0;
   const std::filesystem::path dir = out;
 
@@ -646,6 +651,11 @@ int run(const std::vector<std::string>& args) {
     const auto& r = results[i];
     nlohmann::ordered_json e;
     e["name"] = r.name;
+    {  // the robot as `nhdyn view` finds it again: a preset's name, or the file's absolute path
+      std::error_code ec;
+      const auto p = std::filesystem::absolute(specs[i].robot, ec);
+      e["robot"] = !ec && std::filesystem::is_regular_file(p, ec) ? p.string() : specs[i].robot;
+    }
     e["success"] = r.success;
     e["max_tail_error"] = std::isfinite(r.max_tail_error) ? nlohmann::ordered_json(r.max_tail_error) : nullptr;
     e["steps"] = r.steps;
@@ -725,6 +735,14 @@ int run(const std::vector<std::string>& args) {
                              : std::to_string(threads ? unsigned(threads) : std::thread::hardware_concurrency()) + " threads")
             << "); files in " << dir.string() << '\n';
   if (!no_plots) plot(dir, groups, names, results);
+  if (html) {
+    try {
+      std::cout << "page: " << write_view_page(dir, "", "", {}).string() << '\n';
+    } catch (const std::exception& e) {  // the runs are written; the page is the extra
+      std::cerr << "nhdyn simulate: --html: " << e.what() << '\n';
+      return 1;
+    }
+  }
   return failed ? 1 : 0;
 }
 }  // namespace

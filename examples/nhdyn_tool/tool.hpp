@@ -145,6 +145,14 @@ inline constexpr std::string_view terms_help =
     rad/s or m/s) instead of the exact sign law (0 at rest, as the Robotics Toolbox).
 )";
 
+/// `nhdyn view`'s page of an `nhdyn simulate` folder (view.cpp): the runs' CSVs in
+/// summary.json's order (at most max_runs), the robot `model` (or, when empty, summary.json's
+/// "robot"), meshes through package_paths; writes `out` (empty: run_dir/view.html) and returns
+/// its path. Throws nhdyn::error naming the file at fault.
+std::filesystem::path write_view_page(const std::filesystem::path& run_dir, const std::string& model,
+                                      const std::filesystem::path& out, const std::vector<std::string>& package_paths,
+                                      int max_runs = 40);
+
 /// Where the tool's shipped data lives: `share/nhdyn` beside the folder of the running
 /// `nhdyn` (its `bin/`), as `cmake --install` and the build tree (`build/bin/nhdyn`,
 /// `build/share/nhdyn`) lay it out.
