@@ -5,6 +5,8 @@
 ///   nh_pair/<model>/{fixed, run_time}           nh id and the holonomic rne at the lifted state,
 ///                                               timed in alternating blocks (counter `ratio`)
 ///   scene/<model>/<variant>                     "model only what a scene requires"
+///   requires/<robot>/{full, locked}/<variant>   the same on a robot file: joints held, terms
+///                                               (counter arm_rel_err: the accuracy it costs)
 ///   nh_inertia/<model>/{crba, rne_columns}      M_η = SᵀMS two ways
 ///   rne/<tree>/{nhdyn, reference, kdl}          rne on kinematic trees (the kernel, the plain
 ///   crba/<tree>/{nhdyn, reference}               spatial-algebra reference, KDL's tree solver);
@@ -687,6 +689,101 @@ void register_wheeled(const std::string& model, const nhdyn::tree<double>& t, co
     benchmark::DoNotOptimize(r);
   });
 }
+
+/// "Model only what the scene requires" on one robot file (the TIAGo-style robot): the cost of
+/// the nonholonomic inverse and forward dynamics of the full model and of it with joints held
+/// (nhdyn::lock through the robot file's machinery), and of each choice of terms; the counter
+/// `arm_rel_err` says what a choice costs in accuracy: |τ − τ_ref|∞ / |τ_ref|∞ over the kept
+/// actuators, τ_ref the full model's with every term (friction included) at a state where the
+/// held joints move too: each joint entry of η uniform within its URDF velocity limit (1 where
+/// it has none), η̇ the same in per-second units, q uniform in [−1, 1].
+void register_requires(const std::string& name, const nhdyn::io::robot_model& full,
+                       const std::vector<std::pair<std::string, double>>& held) {
+  const auto& cf = std::get<nhdyn::wheeled_base<double>>(*full.constraint);
+  const auto r = nhdyn::io::lock_robot(full, held, "bench: ");
+  const auto& cr = std::get<nhdyn::wheeled_base<double>>(*r.constraint);
+  const auto jf = full.model.joint_names(), jr = r.model.joint_names();
+  const auto ef = cf.eta_names(jf), er = cr.eta_names(jr), tf = full.tau_names(), tr = r.tau_names();
+  const auto index = [](const std::vector<std::string>& from, const std::vector<std::string>& names) {
+    std::vector<Eigen::Index> out;
+    for (const auto& n : names) out.push_back(std::find(from.begin(), from.end(), n) - from.begin());
+    return out;
+  };
+  const auto iq = index(jf, jr), ie = index(ef, er), it = index(tf, tr);
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  Eigen::VectorXd scale = Eigen::VectorXd::Ones(cf.m());
+  for (int i = 0; i < cf.m(); ++i) {
+    const auto j = std::find(jf.begin(), jf.end(), ef[std::size_t(i)]);
+    if (j != jf.end() && std::isfinite(full.model[int(j - jf.begin())].limits.velocity))
+      scale(i) = full.model[int(j - jf.begin())].limits.velocity;
+  }
+  const Eigen::VectorXd q = Eigen::VectorXd::NullaryExpr(cf.dof(), [&] { return U(rng); });
+  const Eigen::VectorXd eta = Eigen::VectorXd::NullaryExpr(cf.m(), [&] { return U(rng); }).cwiseProduct(scale),
+                        eta_dot = Eigen::VectorXd::NullaryExpr(cf.m(), [&] { return U(rng); }).cwiseProduct(scale);
+  Eigen::VectorXd qr = q(iq), etar = eta(ie), eta_dotr = eta_dot(ie);
+  const Eigen::VectorXd tau_ref = nhdyn::inverse_dynamics(full.model, cf, {}, nhdyn::friction(full.model))(q, eta, eta_dot);
+  const Eigen::VectorXd ref_kept = tau_ref(it);
+  const auto rel_err = [&](const Eigen::VectorXd& tau) {
+    return (tau - ref_kept).lpNorm<Eigen::Infinity>() / ref_kept.lpNorm<Eigen::Infinity>();
+  };
+  const auto case_ = [&](const std::string& variant, auto id, const Eigen::VectorXd& qq, const Eigen::VectorXd& ee,
+                         const Eigen::VectorXd& ed, double err) {
+    auto fp = std::make_shared<decltype(id)>(std::move(id));
+    const std::string full_name = "requires/" + name + "/" + variant;
+    benchmark::RegisterBenchmark(full_name.c_str(), [fp, qq, ee, ed, err](benchmark::State& st) mutable {
+      const auto call = [&] {
+        opaque(qq), opaque(ee), opaque(ed);
+        auto tau = (*fp)(qq, ee, ed);
+        benchmark::DoNotOptimize(tau);
+      };
+      st.counters["allocs_per_call"] = allocs_per_call(call);
+      st.counters["arm_rel_err"] = err;
+      st.counters["dof"] = double(qq.size());
+      for (auto _ : st) call();
+    });
+  };
+  const auto kept = [&](const Eigen::VectorXd& tau_full) { return Eigen::VectorXd(tau_full(it)); };
+  // the full model with every term (the reference), and with the default terms (no friction)
+  case_("full/all", nhdyn::inverse_dynamics(full.model, cf, {}, nhdyn::friction(full.model)), q, eta, eta_dot, 0.0);
+  case_("full/default", nhdyn::inverse_dynamics(full.model, cf), q, eta, eta_dot,
+        rel_err(kept(nhdyn::inverse_dynamics(full.model, cf)(q, eta, eta_dot))));
+  // held joints: the kept joints' torques, the held ones treated as still; then each term
+  // left out of that model in turn
+  const auto held_id = [&](nhdyn::rne_options o) { return nhdyn::inverse_dynamics(r.model, cr, o, nhdyn::friction(r.model)); };
+  const auto lr = [&](nhdyn::rne_options o) { return nhdyn::inverse_dynamics(r.model, cr, o); };
+  case_("locked/all", held_id({}), qr, etar, eta_dotr, rel_err(held_id({})(qr, etar, eta_dotr)));
+  case_("locked/default", lr({}), qr, etar, eta_dotr, rel_err(lr({})(qr, etar, eta_dotr)));
+  case_("locked/all_but_velocity", held_id({true, false}), qr, etar, eta_dotr, rel_err(held_id({true, false})(qr, etar, eta_dotr)));
+  case_("locked/all_but_gravity", held_id({false, true}), qr, etar, eta_dotr, rel_err(held_id({false, true})(qr, etar, eta_dotr)));
+  // exactness of the held model where the held joints do hold still: its torques are the
+  // full model's kept rows
+  Eigen::VectorXd qs = q, es = eta, eds = eta_dot;
+  for (const auto& [joint, x] : r.locked) {
+    qs(std::find(jf.begin(), jf.end(), joint) - jf.begin()) = x;
+    const auto e = std::find(ef.begin(), ef.end(), joint) - ef.begin();
+    es(e) = eds(e) = 0;
+  }
+  agree(lr({})(Eigen::VectorXd(qs(iq)), Eigen::VectorXd(es(ie)), Eigen::VectorXd(eds(ie))),
+        kept(nhdyn::inverse_dynamics(full.model, cf)(qs, es, eds)), 1e-10, "requires/" + name + ": held model = full model's rows");
+  // forward dynamics, full and held
+  const auto fdf = nhdyn::nh_forward_dynamics(full.model, cf);
+  const auto fdr = nhdyn::nh_forward_dynamics(r.model, cr);
+  const Eigen::VectorXd tauf = nhdyn::inverse_dynamics(full.model, cf)(q, eta, eta_dot),
+                        taur = lr({})(qr, etar, eta_dotr);
+  agree(fdr(qr, etar, taur), eta_dotr, 1e-8, "requires/" + name + ": held fd inverts id");
+  add("requires/" + name + "/full/fd", [fdf, q, eta, tauf]() mutable {
+    opaque(q), opaque(eta), opaque(tauf);
+    auto r = fdf(q, eta, tauf);
+    benchmark::DoNotOptimize(r);
+  });
+  add("requires/" + name + "/locked/fd", [fdr, qr, etar, taur]() mutable {
+    opaque(qr), opaque(etar), opaque(taur);
+    auto r = fdr(qr, etar, taur);
+    benchmark::DoNotOptimize(r);
+  });
+  benchmark::AddCustomContext("requires_" + name + "_dof", std::to_string(cf.dof()) + " full, " + std::to_string(cr.dof()) + " held");
+}
 #endif
 
 }  // namespace nhdyn_bench
@@ -743,6 +840,8 @@ int main(int argc, char** argv) {
       register_wheeled("mobile_manipulator_wheels_as_wheeled_base", r.model, wb);
     }
   }
+  register_requires("tiago_style", nhdyn::io::load_robot_file(NHDYN_SOURCE_DIR "/examples/robots/tiago_style.json"),
+                    {{"hand_*", 0.1}, {"head_*", 0.2}});
 #endif
   std::mt19937_64 tree_rng(41);
   std::vector<std::pair<std::string, nhdyn::tree<double>>> trees;
