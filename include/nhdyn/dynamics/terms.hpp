@@ -1,7 +1,7 @@
 #pragma once
 /// \file dynamics/terms.hpp
 /// Which terms of the equations of motion a computation includes, by name — the same names
-/// at every interface (C++, the tool's `--terms`, Python's `terms=`, a scene's "terms"):
+/// at every interface (C++, the tool's `--terms`, Python's `terms=`, a scene's plant and model "terms"):
 ///
 ///     τ = M(q) q̈ + I_a q̈ + C(q, q̇) q̇ + g(q) + τ_f(q̇)
 ///              ──────── ─────────── ────   ──────
