@@ -96,7 +96,7 @@ any_model load_any_model(const std::string& spec, bool strict, const std::vector
     if (!locks.empty())
       throw nhdyn::model_error("--lock: '" + spec + "' is a DH model (a preset or a JSON model): --lock takes URDF files "
                                "and robot files");
-    return {load_model(spec), std::nullopt, std::nullopt, {}};
+    return {load_model(spec), std::nullopt, std::nullopt, {}, {}};
   }
 #ifdef NHDYN_TOOL_URDF
   nhdyn::io::urdf_options o;
@@ -106,11 +106,11 @@ any_model load_any_model(const std::string& spec, bool strict, const std::vector
     // the robot file's name (its "name", else the URDF's) names the model in output and messages
     const auto& t = r.model;
     return {std::nullopt, nhdyn::tree<double>(t.bodies(), t.gravity(), r.name, t.validation_policy(), t.root_name(), t.frames()),
-            r.constraint, r.locked};
+            r.constraint, r.locked, {}};
   }
   // a URDF is a robot without a constraint: lock_robot locks its tree and names what it held
   auto r = nhdyn::io::lock_robot({nhdyn::io::load_urdf(spec, o), std::nullopt, ""}, locks, "--lock: ");
-  return {std::nullopt, std::move(r.model), std::nullopt, std::move(r.locked)};
+  return {std::nullopt, std::move(r.model), std::nullopt, std::move(r.locked), {}};
 #else
   (void)strict;
   throw nhdyn::model_error(spec + ": this nhdyn was built without URDF support (urdfdom, tinyxml2)");
