@@ -23,6 +23,16 @@ def tool(model, lines):
     return [json.loads(l) for l in out.splitlines()]
 
 
+def load_robot_or_skip(path):
+    """nhdyn.load(path) of a robot file; the test is skipped when nhdyn was built without URDF support."""
+    try:
+        return nhdyn.load(path)
+    except nhdyn.ModelError as e:
+        if "without URDF support" in str(e):
+            pytest.skip(str(e))
+        raise
+
+
 def test_models_load_with_names_and_sizes():
     assert "paper5" in nhdyn.presets() and "puma560_motors" in nhdyn.presets()
     p = nhdyn.load("paper5")
@@ -137,12 +147,7 @@ def test_help_shows_signatures_and_units():
 @pytest.mark.skipif(not hasattr(nhdyn, "load"), reason="")
 def test_a_robot_file_runs_the_papers_method():
     path = os.path.join(SOURCE, "examples", "robots", "mobile_manipulator_wheels.json")
-    try:
-        r = nhdyn.load(path)
-    except nhdyn.ModelError as e:
-        if "without URDF support" in str(e):
-            pytest.skip(str(e))
-        raise
+    r = load_robot_or_skip(path)
     assert (r.dof, r.k, r.eta[0]) == (19, 3, "wheel_left_joint")
     rng = np.random.default_rng(4)
     q, eta, eta_dot = rng.uniform(-1, 1, r.dof), rng.uniform(-1, 1, r.m), rng.uniform(-1, 1, r.m)
@@ -418,12 +423,7 @@ def test_stages_compose_in_python_as_the_paper_composes_them():
                                         ("castor_drive_arm.json", 15, 7, 8), ("powered_castors_arm.json", 19, 8, 16)])
 def test_every_wheeled_base_from_python(file, n, k, p):
     path = os.path.join(SOURCE, "examples", "robots", file)
-    try:
-        r = nhdyn.load(path)
-    except nhdyn.ModelError as e:
-        if "without URDF support" in str(e):
-            pytest.skip(str(e))
-        raise
+    r = load_robot_or_skip(path)
     assert (r.dof, r.k, r.m, r.p, len(r.tau)) == (n, k, n - k, p, p)
     assert not any(t.startswith("base_") for t in r.tau)
     rng = np.random.default_rng(31)
@@ -454,12 +454,7 @@ def test_locked_joints_from_python():
     """load(locked=...) on a robot file: the kept rows of the full robot's torques, with the
     locked joints at their positions and at rest; the tool's --lock gives the same numbers."""
     path = os.path.join(SOURCE, "examples", "robots", "mobile_manipulator_wheels.json")
-    try:
-        full = nhdyn.load(path)
-    except nhdyn.ModelError as e:
-        if "without URDF support" in str(e):
-            pytest.skip(str(e))
-        raise
+    full = load_robot_or_skip(path)
     r = nhdyn.load(path, locked={"head_*": 0.3, "arm_7_joint": -0.5})
     assert r.locked == {"head_pan_joint": 0.3, "head_tilt_joint": 0.3, "arm_7_joint": -0.5}
     assert (r.dof, r.m) == (full.dof - 3, full.m - 3)
@@ -503,12 +498,7 @@ def test_terms_from_python():
     with pytest.raises(nhdyn.InputError, match="do not include friction"):
         nhdyn.rne(p, terms="gravity", smooth=0.1)
     path = os.path.join(SOURCE, "examples", "robots", "mobile_manipulator_castors.json")
-    try:
-        r = nhdyn.load(path)
-    except nhdyn.ModelError as e:
-        if "without URDF support" in str(e):
-            pytest.skip(str(e))
-        raise
+    r = load_robot_or_skip(path)
     rng = np.random.default_rng(4)
     q, eta, eta_dot = rng.uniform(-1, 1, r.dof), rng.uniform(-1, 1, r.m), rng.uniform(-1, 1, r.m)
     with_f = nhdyn.inverse_dynamics(r, terms="all")(q, eta, eta_dot)
