@@ -345,6 +345,24 @@ ordered_json robot_json(const page_robot& r, const std::vector<std::string>& pac
   return j;
 }
 
+/// Writes the page of `robot` and `runs` to `page` (the data of viewer/README.md); names
+/// the meshes that did not resolve on stderr.
+std::filesystem::path write_page(const page_robot& robot, const std::string& title, ordered_json runs,
+                                 const std::filesystem::path& page, const std::vector<std::string>& package_paths) {
+  std::vector<std::string> missing;
+  ordered_json data;
+  data["version"] = 1;
+  data["title"] = title;
+  data["up"] = {robot.up.x(), robot.up.y(), robot.up.z()};
+  data["robot"] = robot_json(robot, package_paths, missing);
+  data["runs"] = std::move(runs);
+  for (const auto& m : missing) std::cerr << "nhdyn view: mesh not found, the page draws a stand-in: " << m << '\n';
+  std::ofstream(page, std::ios::binary) << page_of(data);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(page, ec)) throw nhdyn::input_error("nhdyn view: cannot write '" + page.string() + "'");
+  return page;
+}
+
 }  // namespace
 
 std::filesystem::path write_view_page(const std::filesystem::path& run_dir, const std::string& model,
@@ -393,19 +411,10 @@ std::filesystem::path write_view_page(const std::filesystem::path& run_dir, cons
     if (summary.count(n) && summary[n].contains("success")) r["success"] = summary[n]["success"];
     runs.push_back(r);
   }
-  std::vector<std::string> missing;
-  ordered_json data;
-  data["version"] = 1;
   // the page adds the shown run's name to the title
-  data["title"] = order.size() == 1 ? robot.name : robot.name + " — " + fs::absolute(run_dir).lexically_normal().filename().string();
-  data["up"] = {robot.up.x(), robot.up.y(), robot.up.z()};
-  data["robot"] = robot_json(robot, package_paths, missing);
-  data["runs"] = runs;
-  for (const auto& m : missing) std::cerr << "nhdyn view: mesh not found, the page draws a stand-in: " << m << '\n';
-  const fs::path page = out.empty() ? run_dir / "view.html" : out;
-  std::ofstream(page, std::ios::binary) << page_of(data);
-  if (!fs::is_regular_file(page, ec)) throw nhdyn::input_error("nhdyn view: cannot write '" + page.string() + "'");
-  return page;
+  const std::string title =
+      order.size() == 1 ? robot.name : robot.name + " — " + fs::absolute(run_dir).lexically_normal().filename().string();
+  return write_page(robot, title, std::move(runs), out.empty() ? run_dir / "view.html" : out, package_paths);
 }
 
 namespace {
@@ -428,20 +437,9 @@ std::filesystem::path pose_page(const std::string& model, const std::string& q_t
                         " joints (`nhdyn model` lists them)");
     q = v;
   }
-  std::vector<std::string> missing;
-  ordered_json data;
-  data["version"] = 1;
-  data["title"] = robot.name;
-  data["up"] = {robot.up.x(), robot.up.y(), robot.up.z()};
-  data["robot"] = robot_json(robot, package_paths, missing);
-  data["runs"] = ordered_json::array({ordered_json{{"name", "pose"}, {"t", {0.0}}, {"q", {q}}, {"columns", ordered_json::object()},
-                                                   {"task", ordered_json::object()}}});
-  for (const auto& m : missing) std::cerr << "nhdyn view: mesh not found, the page draws a stand-in: " << m << '\n';
-  const std::filesystem::path page = out.empty() ? std::filesystem::path(robot.name + ".html") : out;
-  std::ofstream(page, std::ios::binary) << page_of(data);
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(page, ec)) throw nhdyn::input_error("nhdyn view: cannot write '" + page.string() + "'");
-  return page;
+  const ordered_json runs = ordered_json::array({ordered_json{
+      {"name", "pose"}, {"t", {0.0}}, {"q", {q}}, {"columns", ordered_json::object()}, {"task", ordered_json::object()}}});
+  return write_page(robot, robot.name, runs, out.empty() ? std::filesystem::path(robot.name + ".html") : out, package_paths);
 }
 
 int run(const std::vector<std::string>& args) {
