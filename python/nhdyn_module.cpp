@@ -79,6 +79,18 @@ bool is_robot_file(const std::string& spec) {
   return j.is_object() && j.contains("urdf");
 }
 
+#if NHDYN_PY_URDF
+/// A robot (a robot file's, or a DH model's with joints held) as the module's model.
+void take_robot(model& out, nhdyn::io::robot_model r) {
+  out.name = r.name;
+  out.eta = r.eta_names();
+  out.tau = r.tau_names();
+  out.locked = r.locked;
+  out.tree = std::move(r.model);
+  out.tree_constraint = r.constraint;
+}
+#endif
+
 std::shared_ptr<model> load(const std::string& spec, bool strict, const std::map<std::string, double>& locked) {
   auto out = std::make_shared<model>();
   out->source = spec;
@@ -89,13 +101,7 @@ std::shared_ptr<model> load(const std::string& spec, bool strict, const std::map
     nhdyn::io::urdf_options o;
     o.strict = strict;
     if (robot) {
-      auto r = nhdyn::io::lock_robot(nhdyn::io::load_robot_file(spec, o), locks, "locked: ");
-      out->name = r.name;
-      out->eta = r.eta_names();
-      out->tau = r.tau_names();
-      out->locked = r.locked;
-      out->tree = std::move(r.model);
-      out->tree_constraint = r.constraint;
+      take_robot(*out, nhdyn::io::lock_robot(nhdyn::io::load_robot_file(spec, o), locks, "locked: "));
     } else {
       // a URDF is a robot without a constraint: lock_robot locks its tree and names what it held
       auto r = nhdyn::io::lock_robot({nhdyn::io::load_urdf(spec, o), std::nullopt, ""}, locks, "locked: ");
@@ -111,10 +117,18 @@ std::shared_ptr<model> load(const std::string& spec, bool strict, const std::map
 #endif
   }
   (void)strict;
-  if (!locks.empty())
-    throw nhdyn::model_error("locked: '" + spec + "' is a DH model (a preset or a JSON model): locked= takes URDF files "
-                             "and robot files");
   auto m = nhdyn::io::load<double>(spec);
+  if (!locks.empty() || !m.locked.empty()) {
+#if NHDYN_PY_URDF
+    // a DH chain with joints held is a tree (io::as_robot): the file's "locked", then locked=
+    take_robot(*out, nhdyn::io::lock_robot(nhdyn::io::as_robot(m, "model '" + spec + "', locked: "), locks, "locked: "));
+    out->joints = out->tree->joint_names();
+    return out;
+#else
+    throw nhdyn::model_error("'" + spec + "': locking joints of a DH model makes a tree, and this nhdyn module was built "
+                             "without tree support (liburdfdom-dev, libtinyxml2-dev)");
+#endif
+  }
   out->name = m.chain.name();
   for (int i = 0; i < m.chain.dof(); ++i) out->joints.push_back("joint" + std::to_string(i + 1));
   out->eta = m.constraint ? m.constraint->eta_names(out->joints) : out->joints;
@@ -805,8 +819,8 @@ spec: a preset name (nhdyn.presets()), a JSON model file, a URDF file (*.urdf) o
 file (JSON with a "urdf" key: a URDF on a wheeled base with its constraint). strict: a
 non-physical URDF inertia is an error instead of a warning on stderr. locked: {joint name
 or shell glob: position [rad or m]}: those joints held there, their links merged into their
-parents (URDF and robot files; a constraint's joints cannot be locked); Model.locked lists
-them. Raises ModelError with the file, link and field at fault.)");
+parents (a DH model so held becomes a tree with joints joint1..; a constraint's joints
+cannot be locked; a JSON model's own "locked" is applied too); Model.locked lists them. Raises ModelError with the file, link and field at fault.)");
   mod.def("rne", [](const model& m, const std::optional<py::list>& w, const py::object& terms, double smooth) {
             if (!terms.is_none() || smooth != 0) {
               const auto t = terms_from(terms.is_none() ? py::str("gravity,velocity,armature") : terms, smooth);

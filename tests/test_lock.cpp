@@ -599,3 +599,70 @@ TEST_CASE("lock: the TIAGo-style robot with its hand and head held keeps the pap
   check_locked_robot(full, r, 36, 1e-10);
 }
 #endif
+
+#ifdef NHDYN_HAVE_URDF
+namespace {
+/// A JSON (DH) model with "locked", as io::as_robot gives it, against the full chain (the DH
+/// kernels): the nonholonomic τ and λ of the kept η entries with the locked joints at their
+/// positions, at rest.
+void check_locked_chain(const io::model<double>& m, std::uint64_t seed) {
+  const io::robot_model r = io::as_robot(m, "test: ");
+  const int n = m.chain.dof();
+  REQUIRE(r.model.dof() == n - int(m.locked.size()));
+  const auto& cf = *m.constraint;
+  const auto& cr = std::get<differential_drive<double>>(*r.constraint);
+  std::vector<std::string> jf;
+  for (int i = 1; i <= n; ++i) jf.push_back("joint" + std::to_string(i));
+  const auto jr = r.model.joint_names();
+  const auto ef = cf.eta_names(jf), er = cr.eta_names(jr);
+  const auto index = [](const std::vector<std::string>& from, const std::vector<std::string>& names) {
+    std::vector<int> out;
+    for (const auto& name : names) out.push_back(int(std::find(from.begin(), from.end(), name) - from.begin()));
+    return out;
+  };
+  std::mt19937_64 rng(seed);
+  for (int s = 0; s < 5; ++s) {
+    VectorXd q = random_state(rng, n), eta = random_state(rng, cf.m()), eta_dot = random_state(rng, cf.m());
+    for (const auto& [name, x] : r.locked) {
+      q(std::find(jf.begin(), jf.end(), name) - jf.begin()) = x;
+      const auto e = std::find(ef.begin(), ef.end(), name) - ef.begin();
+      eta(e) = eta_dot(e) = 0;
+    }
+    const auto ff = inverse_dynamics_with_forces(m.chain, cf)(q, eta, eta_dot);
+    const auto fr = inverse_dynamics_with_forces(r.model, cr)(rows(q, index(jf, jr)), rows(eta, index(ef, er)),
+                                                              rows(eta_dot, index(ef, er)));
+    CHECK(rel(fr.tau, rows(ff.tau, index(ef, er))) < 1e-12);
+    CHECK(rel(fr.lambda, ff.lambda) < 1e-12);
+  }
+}
+}  // namespace
+
+TEST_CASE("lock: a JSON (DH) model's \"locked\" is its chain as a tree with those joints held; the paper's method stays exact",
+          "[lock][urdf]") {
+  // paper5 with its last arm joint held; the file's round trip carries "locked"
+  auto p5 = io::load("paper5");
+  p5.locked = {{"joint5", 0.7}};
+  const auto m = io::parse_model(io::to_string(p5), "test");
+  REQUIRE(m.locked == lock_list{{"joint5", 0.7}});
+  REQUIRE(m.chain.dof() == 5);  // io::load keeps the full chain
+  check_locked_chain(m, 41);
+  // puma560 under a differential drive on joints 3-5 with joints 1 and 6 held: the
+  // constraint's indices move down by one in the smaller tree
+  auto j = io::to_json(io::load("puma560"));
+  j["constraint"] = io::ordered_json::parse(R"({"type": "differential_drive", "x": 2, "y": 3, "heading": 4})");
+  j["locked"] = io::ordered_json::parse(R"({"joint1": 0.3, "joint6": -0.2})");
+  const auto puma = io::parse_model(j.dump(), "test");
+  const auto r = io::as_robot(puma);
+  const auto& c = std::get<differential_drive<double>>(*r.constraint);
+  CHECK((c.n == 4 && c.x == 1 && c.y == 2 && c.heading == 3));
+  CHECK(r.locked == lock_list{{"joint1", 0.3}, {"joint6", -0.2}});
+  check_locked_chain(puma, 42);
+  // a joint of the constraint cannot be held; "locked" is checked as a robot file's is
+  p5.locked = {{"joint[2-3]", 0.0}};
+  CHECK_THROWS_WITH(io::as_robot(p5, "model 'p', locked: "),
+                    Contains("model 'p', locked: ") && Contains("'joint2' belongs to the constraint (differential_drive)"));
+  j["locked"] = io::ordered_json::parse(R"({"joint2": "up"})");
+  CHECK_THROWS_WITH(io::parse_model(j.dump(), "file 'x.json'"),
+                    Contains("file 'x.json'") && Contains("field 'locked'") && Contains("'joint2': expected a finite position"));
+}
+#endif

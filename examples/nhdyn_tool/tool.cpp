@@ -93,10 +93,17 @@ std::vector<std::pair<std::string, double>> parse_locks(const std::string& text)
 any_model load_any_model(const std::string& spec, bool strict, const std::vector<std::pair<std::string, double>>& locks) {
   const bool robot = !is_urdf(spec) && is_robot_file(spec);
   if (!is_urdf(spec) && !robot) {
-    if (!locks.empty())
-      throw nhdyn::model_error("--lock: '" + spec + "' is a DH model (a preset or a JSON model): --lock takes URDF files "
-                               "and robot files");
-    return {load_model(spec), std::nullopt, std::nullopt, {}, {}};
+    auto m = load_model(spec);
+    if (locks.empty() && m.locked.empty()) return {std::move(m), std::nullopt, std::nullopt, {}, {}};
+#ifdef NHDYN_TOOL_URDF
+    // a DH chain with joints held is a tree (io::as_robot): the file's "locked", then --lock
+    auto r = nhdyn::io::lock_robot(nhdyn::io::as_robot(m, "model '" + spec + "', locked: "), locks, "--lock: ");
+    std::vector<std::pair<std::string, double>> held = std::move(r.locked);
+    return {std::nullopt, std::move(r.model), r.constraint, std::move(held), {}};
+#else
+    throw nhdyn::model_error("'" + spec + "': locking joints of a DH model makes a tree, and this nhdyn was built "
+                             "without tree support (urdfdom, tinyxml2)");
+#endif
   }
 #ifdef NHDYN_TOOL_URDF
   nhdyn::io::urdf_options o;

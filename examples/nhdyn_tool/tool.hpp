@@ -111,7 +111,8 @@ std::optional<nhdyn::friction_fn> friction_of(const Model& model, const nhdyn::t
 bool is_urdf(const std::string& spec);
 /// load_model, URDF files (*.urdf) and robot files (JSON with a "urdf" key); `strict`: a non-physical inertia in a URDF is an error
 /// instead of a warning on stderr; `locks`: joints held at positions (names or globs,
-/// nhdyn::lock), for URDF files and robot files.
+/// nhdyn::lock), for every model (a DH chain with joints held, by --lock or its file's
+/// "locked", becomes a tree: io::as_robot).
 any_model load_any_model(const std::string& spec, bool strict = false,
                          const std::vector<std::pair<std::string, double>>& locks = {});
 /// The value of --lock, 'NAME=POSITION,GLOB=POSITION,...': usage_error naming a bad entry.
@@ -125,10 +126,11 @@ std::optional<any_model> start_any_model_command(const std::vector<std::string>&
 /// The help of start_any_model_command's options, the end of each such subcommand's usage.
 inline constexpr std::string_view model_options_help =
     R"(  --strict: a URDF inertia that is not physically valid is an error instead of a warning.
-  --lock 'NAME=POS,GLOB=POS,...': hold those joints (URDF joint names or shell globs: *, ?,
-    [..]) at the positions [rad or m], their links merged into their parents; the model then
-    has the other joints only (URDF files and robot files; a constraint's joints cannot be
-    locked; `nhdyn model` lists what was locked).
+  --lock 'NAME=POS,GLOB=POS,...': hold those joints (joint names or shell globs: *, ?,
+    [..]; a DH model's are joint1, joint2, ...) at the positions [rad or m], their links
+    merged into their parents; the model then has the other joints only (any model; a DH
+    chain so held is a tree; a constraint's joints cannot be locked; `nhdyn model` lists
+    what was locked).
 )";
 /// The help of --terms and --smooth-coulomb.
 inline constexpr std::string_view terms_help =

@@ -477,6 +477,31 @@ def test_locked_joints_from_python():
         nhdyn.load(path, locked={"finger_*": 0.0})
 
 
+def test_locked_dh_model_from_python():
+    """load(preset, locked=...): the DH chain as a tree with those joints held; rne's kept rows
+    equal the full chain's (the DH kernel) with the locked joints at their positions, at rest;
+    paper5's constraint stays on its base joints."""
+    full = nhdyn.load("puma560")
+    try:
+        r = nhdyn.load("puma560", locked={"joint2": 0.3, "joint5": -0.4})
+    except nhdyn.ModelError as e:
+        if "without tree support" in str(e):
+            pytest.skip(str(e))
+        raise
+    assert r.joints == ["joint1", "joint3", "joint4", "joint6"]
+    assert r.locked == {"joint2": 0.3, "joint5": -0.4}
+    rng = np.random.default_rng(13)
+    q, qd, qdd = (rng.uniform(-1, 1, 6) for _ in range(3))
+    q[[1, 4]] = [0.3, -0.4]
+    qd[[1, 4]] = qdd[[1, 4]] = 0.0
+    kept = [0, 2, 3, 5]
+    assert np.allclose(nhdyn.rne(r)(q[kept], qd[kept], qdd[kept]), nhdyn.rne(full)(q, qd, qdd)[kept], rtol=1e-12, atol=1e-12)
+    p5 = nhdyn.load("paper5", locked={"joint5": 0.1})
+    assert (p5.dof, p5.m) == (4, 3)
+    with pytest.raises(nhdyn.ModelError, match="'joint1' belongs to the constraint"):
+        nhdyn.load("paper5", locked={"joint1": 0.0})
+
+
 def test_terms_from_python():
     """rne(terms=...) and inverse_dynamics(terms=...): the Robotics Toolbox's rne(qn, 1, 1)
     (friction included) on puma560_motors, the tool's --terms numbers, and a robot file whose

@@ -334,9 +334,73 @@ TEST_CASE("tool: --lock holds joints of a robot file: model lists them, id equal
   r = run_tool("model --model '" + file + "' --lock 'arm_1_joint'");
   CHECK(r.status == 2);
   CHECK(r.err.find("'arm_1_joint' is not NAME=POSITION") != std::string::npos);
-  r = run_tool("model --model puma560 --lock 'joint1=0'");
+}
+
+TEST_CASE("tool: --lock on DH models (presets, JSON models): the chain's kept entries, its constraint on the kept joints") {
+  // puma560 with joints 2 and 5 held: the locked tree's id (tree kernel) = the full chain's
+  // (DH kernel) at q2 = 0.3, q5 = -0.4 at rest, rows 1, 3, 4, 6
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const auto rand = [&](int n) { return VectorXd(VectorXd::NullaryExpr(n, [&] { return u(rng); })); };
+  const auto pick = [](const VectorXd& v, const std::vector<int>& idx) {
+    VectorXd out(static_cast<Eigen::Index>(idx.size()));
+    for (std::size_t k = 0; k < idx.size(); ++k) out(Eigen::Index(k)) = v(idx[k]);
+    return out;
+  };
+  VectorXd q = rand(6), qd = rand(6), qdd = rand(6);
+  q(1) = 0.3, q(4) = -0.4, qd(1) = qd(4) = qdd(1) = qdd(4) = 0;
+  const std::vector<int> kept{0, 2, 3, 5};
+  auto r = run_tool("model --model puma560 --lock 'joint2=0.3,joint5=-0.4'");
+  REQUIRE(r.status == 0);
+  json j = json::parse(r.lines[0]);
+  CHECK(j["dof"] == 4);
+  CHECK(j["joints"] == json::parse(R"(["joint1", "joint3", "joint4", "joint6"])"));
+  CHECK(j["locked"] == json::parse(R"({"joint2": 0.3, "joint5": -0.4})"));
+  auto full = run_tool("id --model puma560", R"({"q": )" + arr(q) + R"(, "qd": )" + arr(qd) + R"(, "qdd": )" + arr(qdd) + "}\n");
+  auto held = run_tool("id --model puma560 --lock 'joint[25]=0.3,joint5=-0.4'",
+                       R"({"q": )" + arr(pick(q, kept)) + R"(, "qd": )" + arr(pick(qd, kept)) + R"(, "qdd": )" +
+                           arr(pick(qdd, kept)) + "}\n");
+  // joint[25] matches joint5 too, which the second entry also names: an error naming both
+  CHECK(held.status != 0);
+  CHECK(held.err.find("joint5") != std::string::npos);
+  held = run_tool("id --model puma560 --lock 'joint2=0.3,joint5=-0.4'",
+                  R"({"q": )" + arr(pick(q, kept)) + R"(, "qd": )" + arr(pick(qd, kept)) + R"(, "qdd": )" +
+                      arr(pick(qdd, kept)) + "}\n");
+  REQUIRE(full.status == 0);
+  REQUIRE(held.status == 0);
+  VectorXd want = pick(field(full.lines[0], "tau"), kept);
+  CHECK((field(held.lines[0], "tau") - want).norm() <= 1e-12 * std::max(1.0, want.norm()));
+
+  // paper5 (a differential drive on joints 1-3) as a JSON model file whose own "locked" holds
+  // joint 4: its η is (v, ω, q̇5) and τ the full chain's entries for them
+  auto m = nhdyn::io::load("paper5");
+  m.locked = {{"joint4", 0.6}};
+  const auto file = fs::temp_directory_path() / ("nhdyn_test_tool_p5_locked_" + std::to_string(::getpid()) + ".json");
+  nhdyn::io::save_model(m, file);
+  VectorXd q5 = rand(5), eta = rand(4), eta_dot = rand(4);
+  q5(3) = 0.6, eta(2) = eta_dot(2) = 0;  // η = (v, ω, q̇4, q̇5)
+  full = run_tool("id --model paper5", R"({"q": )" + arr(q5) + R"(, "eta": )" + arr(eta) + R"(, "eta_dot": )" + arr(eta_dot) + "}\n");
+  held = run_tool("id --model '" + file.string() + "'", R"({"q": )" + arr(pick(q5, {0, 1, 2, 4})) + R"(, "eta": )" +
+                                                            arr(pick(eta, {0, 1, 3})) + R"(, "eta_dot": )" +
+                                                            arr(pick(eta_dot, {0, 1, 3})) + "}\n");
+  REQUIRE(full.status == 0);
+  REQUIRE(held.status == 0);
+  want = pick(field(full.lines[0], "tau"), {0, 1, 3});
+  CHECK((field(held.lines[0], "tau") - want).norm() <= 1e-12 * std::max(1.0, want.norm()));
+  r = run_tool("model --model '" + file.string() + "'");
+  REQUIRE(r.status == 0);
+  j = json::parse(r.lines[0]);
+  CHECK(j["locked"] == json::parse(R"({"joint4": 0.6})"));
+  CHECK(j["eta"].size() == 3);
+  fs::remove(file);
+
+  // the constraint's joints cannot be held; a pattern that matches nothing is named
+  r = run_tool("model --model paper5 --lock 'joint3=0'");
   CHECK(r.status != 0);
-  CHECK(r.err.find("--lock takes URDF files and robot files") != std::string::npos);
+  CHECK(r.err.find("'joint3' belongs to the constraint (differential_drive)") != std::string::npos);
+  r = run_tool("model --model puma560 --lock 'wrist*=0'");
+  CHECK(r.status != 0);
+  CHECK(r.err.find("'wrist*' matches no movable joint") != std::string::npos);
 }
 
 TEST_CASE("tool: --terms on puma560_motors reproduces the Robotics Toolbox's rne(qn, 1, 1); each term off removes its part") {

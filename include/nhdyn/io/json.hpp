@@ -12,7 +12,9 @@
 ///                 | "motor": {"inertia", "gear", "viscous", "coulomb"}}, …],  (or motor side)
 ///      "validation": {"triangle_inequality": true},                (optional)
 ///      "constraint": {"type": "differential_drive", "x": 0, "y": 1, "heading": 2,
-///                     "forward_offset": 0, "heading_sign": -1}}    (optional; 0-based joints)
+///                     "forward_offset": 0, "heading_sign": -1},    (optional; 0-based joints)
+///      "locked": {"joint5": 0.3, "joint[1-2]": 0}}                 (optional: joints held,
+///                                                                    model::locked, as_robot)
 ///
 /// Standard DH (Spong), com in link frame i, inertia about the centre of mass in frame i's
 /// axes, radians and SI units. Every field of a link is required; unknown fields, duplicate
@@ -52,6 +54,11 @@ struct model {
   ::nhdyn::chain<S> chain;
   std::optional<differential_drive<S>> constraint;
   std::string description;
+  /// The file's "locked" joints ({"joint2": 0.3, "joint[4-6]": 0}: as_tree's names, globs),
+  /// in the file's order. `chain` is the full chain: a chain with joints held is no longer a
+  /// DH chain but a tree, and `io::as_robot(m)` (robot_file.hpp) is that tree with the
+  /// constraint on it, as the tool, scenes and Python load such a file.
+  std::vector<std::pair<std::string, double>> locked{};
 };
 
 // ---------------------------------------------------------------------------------------
@@ -178,6 +185,20 @@ inline std::string describe(const json& j) {
   if (j.is_number()) return "number";
   if (j.is_boolean()) return "boolean";
   return j.type_name();
+}
+
+/// A "locked" object: {"NAME or GLOB": position, ...}.
+inline std::vector<std::pair<std::string, double>> read_locked(const json& l, const place& top) {
+  if (!l.is_object())
+    throw model_error(top.field("locked") + "expected an object {\"joint name or glob\": position, ...}, got " + describe(l));
+  std::vector<std::pair<std::string, double>> out;
+  for (auto it = l.begin(); it != l.end(); ++it) {
+    if (!it.value().is_number() || !std::isfinite(it.value().get<double>()))
+      throw model_error(top.field("locked") + "'" + it.key() + "': expected a finite position [rad or m], got " +
+                        (it.value().is_number() ? std::string("a non-finite number") : describe(it.value())));
+    out.emplace_back(it.key(), it.value().get<double>());
+  }
+  return out;
 }
 
 /// Throws if obj has keys outside `allowed` or lacks one of `required`.
@@ -348,7 +369,7 @@ model<S> model_from_json(const json& j, const std::string& source = "") {
   const std::string pre = source.empty() ? "" : source + ", ";
   const detail::place top{source};
   if (!j.is_object()) throw model_error(pre + "expected a JSON object at the top level, got " + detail::describe(j));
-  detail::check_keys(j, {"name", "description", "gravity", "links", "validation", "constraint"},
+  detail::check_keys(j, {"name", "description", "gravity", "links", "validation", "constraint", "locked"},
                      {"name", "gravity", "links"}, pre, "the model");
   const auto name = detail::string_field(j["name"], top, "name");
   std::string description;
@@ -379,9 +400,10 @@ model<S> model_from_json(const json& j, const std::string& source = "") {
                  throw model_error(pre + e.what());
                }
              }(),
-             std::nullopt, description};
+             std::nullopt, description, {}};
   if (j.contains("constraint"))
     m.constraint = detail::read_constraint<S>(j["constraint"], top, m.chain.dof());
+  if (j.contains("locked")) m.locked = detail::read_locked(j["locked"], top);
   return m;
 }
 
@@ -418,17 +440,20 @@ model<S> preset(std::string_view name) {
             differential_drive<S>(c.n, c.x, c.y, c.heading, c.forward_offset, c.heading_sign),
             "The 5-DOF nonholonomic mobile manipulator of Salazar-Silva et al. (Tables I-II): a "
             "differential-drive platform (q1, q2 base position, q3 heading) carrying a planar 2-link "
-            "arm (q4, q5); box inertias from the box formulas; eta = (v, omega, qd4, qd5)"};
+            "arm (q4, q5); box inertias from the box formulas; eta = (v, omega, qd4, qd5)",
+            {}};
   }
   if (name == "puma560")
     return {presets::puma560<S>().dynamic_size(), std::nullopt,
             "Unimation Puma 560, standard DH, rigid-body parameters of P. Corke's Robotics Toolbox "
             "mdl_puma560.m (parameters of 8/95: Corke & Armstrong-Helouvry, ICRA 1994); no motor inertia, gearing or friction; "
-            "links 1 and 3 violate the triangle inequality as published"};
+            "links 1 and 3 violate the triangle inequality as published",
+            {}};
   if (name == "puma560_motors")
     return {presets::puma560_motors<S>().dynamic_size(), std::nullopt,
             "puma560 with its drives from the same file: armature G^2 Jm, viscous friction G^2 B and "
-            "Coulomb friction |G| Tc per joint (joint side); rne adds the armature, friction is a stage"};
+            "Coulomb friction |G| Tc per joint (joint side); rne adds the armature, friction is a stage",
+            {}};
   std::string known;
   for (const auto& n : preset_names()) known += (known.empty() ? "" : ", ") + n;
   throw model_error("unknown preset '" + std::string(name) + "' (known: " + known + ")");
@@ -491,7 +516,13 @@ ordered_json to_json(const chain<S, N>& ch, const differential_drive<S, N>* c = 
 
 template <class S>
 ordered_json to_json(const model<S>& m) {
-  return to_json(m.chain, m.constraint ? &*m.constraint : nullptr, m.description);
+  ordered_json j = to_json(m.chain, m.constraint ? &*m.constraint : nullptr, m.description);
+  if (!m.locked.empty()) {
+    ordered_json l = ordered_json::object();
+    for (const auto& [name, x] : m.locked) l[name] = x;
+    j["locked"] = l;
+  }
+  return j;
 }
 
 /// The model file's text (indented, numbers in their shortest round-trip form).

@@ -26,6 +26,7 @@
 /// - `{"type": "wheeled_base", "wheels": [{"kind": "fixed" | "steered" | "castor" | "swedish",
 ///   "spin": J, …}, …], "eta": […], "actuated": […], "weights": {…}}` (planar base): any set of
 ///   wheels, each rim point at the floor not slipping (wheeled_base, docs/model-format.md).
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -323,19 +324,6 @@ std::vector<bool> constraint_joints(const C& c, int n) {
   return used;
 }
 
-/// A "locked" object: {"NAME or GLOB": position, ...}.
-inline std::vector<std::pair<std::string, double>> read_locked(const json& l, const place& top) {
-  if (!l.is_object())
-    throw model_error(top.field("locked") + "expected an object {\"joint name or glob\": position, ...}, got " + describe(l));
-  std::vector<std::pair<std::string, double>> out;
-  for (auto it = l.begin(); it != l.end(); ++it) {
-    if (!it.value().is_number() || !std::isfinite(it.value().get<double>()))
-      throw model_error(top.field("locked") + "'" + it.key() + "': expected a finite position [rad or m], got " +
-                        (it.value().is_number() ? std::string("a non-finite number") : describe(it.value())));
-    out.emplace_back(it.key(), it.value().get<double>());
-  }
-  return out;
-}
 }  // namespace detail
 
 /// The robot r with the joints that `locks` names or globs held at the given positions
@@ -358,7 +346,9 @@ inline robot_model lock_robot(robot_model r, const std::vector<std::pair<std::st
     const std::string type = r.constraint_source.is_object() && r.constraint_source.contains("type") &&
                                      r.constraint_source["type"].is_string()
                                  ? r.constraint_source["type"].get<std::string>()
-                                 : std::string("the robot's");
+                                 : std::holds_alternative<differential_drive<double>>(*r.constraint)
+                                       ? std::string("differential_drive")
+                                       : std::string("the robot's");
     for (const auto& [i, x] : m.locked)
       if (used[std::size_t(i)])
         throw model_error(where + "joint '" + joints[std::size_t(i)] + "' belongs to the constraint (" + type +
@@ -371,8 +361,29 @@ inline robot_model lock_robot(robot_model r, const std::vector<std::pair<std::st
     opt.planar_base = r.planar_base;
     opt.warn = [](const std::string&) {};  // given when the full robot was read
     r.constraint = detail::read_robot_constraint(r.constraint_source, r.model, detail::place{"robot file '" + r.path + "', locked"}, opt);
+  } else if (r.constraint) {
+    // a JSON model's differential_drive (as_robot) names its joints by index: the kept
+    // joints' indices in the smaller tree
+    auto* dd = std::get_if<differential_drive<double>>(&*r.constraint);
+    if (!dd) throw model_error(where + "the robot's constraint has no source to read again on the smaller tree");
+    const auto index = [&](int j) { return int(std::find(m.kept.begin(), m.kept.end(), j) - m.kept.begin()); };
+    r.constraint = differential_drive<double>(m.dof(), index(dd->x), index(dd->y), index(dd->heading),
+                                              dd->forward_offset, dd->heading_sign);
   }
   return r;
+}
+
+/// A JSON model (a DH chain, its optional differential_drive, its "locked" joints) as a
+/// robot: the chain as a tree (as_tree: joints joint1…, bodies link1…, the base `base`), the
+/// constraint on it with the same joint indices, and the locked joints held (lock_robot:
+/// a joint of the constraint cannot be). A DH chain with joints held is no longer a DH chain;
+/// this is how the tool, scenes and Python load a model file with "locked". `where` begins
+/// the messages about the locked joints.
+inline robot_model as_robot(const model<double>& m, const std::string& where = "locked: ") {
+  robot_model r{.model = as_tree(m.chain), .constraint = std::nullopt, .name = m.chain.name(),
+                .constraint_source = {}, .path = {}, .planar_base = false, .locked = {}};
+  if (m.constraint) r.constraint = *m.constraint;
+  return lock_robot(std::move(r), m.locked, where);
 }
 
 /// The robot file's text; `path` locates the URDF (relative paths from its folder) and names

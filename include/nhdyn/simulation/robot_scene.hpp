@@ -103,10 +103,8 @@ inline io::robot_model load_scene_robot(const std::string& robot) {
     std::ifstream in(robot);
     if (const auto j = nlohmann::json::parse(in, nullptr, false); j.is_object() && j.contains("urdf")) return io::load_robot_file(robot);
   }
-  const io::model<double> m = io::load<double>(robot);
-  io::robot_model r{.model = as_tree(m.chain), .constraint = std::nullopt, .name = m.chain.name(),
-                    .constraint_source = {}, .path = robot, .planar_base = false};
-  if (m.constraint) r.constraint = *m.constraint;
+  io::robot_model r = io::as_robot(io::load<double>(robot), "robot '" + robot + "', locked: ");
+  r.path = robot;
   return r;
 }
 
