@@ -11,9 +11,12 @@
 // - a controller's model without gravity: its first torque differs from the default's by
 //   exactly the projected gradient of the potential energy (central differences of
 //   −Σ mᵢ gᵀ p_cᵢ(q), no rne), and it tracks worse;
-// - errors name the scene and the field.
+// - errors name the scene and the field;
+// - a scene's "locked" (run_spec::locked) gives its robot file's own "locked", bit for bit.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <nhdyn/nhdyn.hpp>
 #include <nhdyn/simulation/robot_scene.hpp>
@@ -236,4 +239,50 @@ TEST_CASE("scene terms: errors name the scene and the field", "[scene_terms]") {
   const run_spec r = parse(mm + R"("plant": {"mass_factor": {"arm_7_link": 2}, "terms": "none"}})");
   CHECK(r.plant_terms == terms{false, false, false, false});
   CHECK(r.plant_mass.size() == 1);
+}
+
+TEST_CASE("scene locked: a scene's \"locked\" holds joints as its robot file's own \"locked\" does, bit for bit",
+          "[scene_terms]") {
+  // the mobile manipulator with its head held at 0.2 rad: its q is the 17 other joints
+  const std::string common = R"("duration": 0.3, "success": {"tail_from": 0.2, "max_tail_error": 1},
+      "initial": {"q": [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.9, 0, -1.4, 0, 0.5, 0]},
+      "controller": {"posture_joints": ["wheel_left_joint", "wheel_right_joint", "torso_lift_joint", "arm_1_joint"]})";
+  const run_spec a = mm_scene("{" + common + R"(, "locked": {"head_*": 0.2}})");
+  REQUIRE(a.locked == std::vector<std::pair<std::string, double>>{{"head_*", 0.2}});
+  // the same robot written as a robot file with "locked"
+  const std::string path = (std::filesystem::temp_directory_path() / "nhdyn_test_scene_locked.json").string();
+  {
+    std::ifstream in(source("examples/robots/mobile_manipulator.json"));
+    auto r = scene::json::parse(in);
+    r["urdf"] = source("examples/urdf/mobile_manipulator.urdf");
+    r["locked"] = scene::json::parse(R"({"head_*": 0.2})");
+    std::ofstream(path) << r.dump();
+  }
+  const run_spec b = mm_scene("{" + common + R"(, "robot": ")" + path + R"("})");
+  const run_spec full = mm_scene(R"({"duration": 0.3, "success": {"tail_from": 0.2, "max_tail_error": 1}})");
+  const run_result ra = simulate_scene(a), rb = simulate_scene(b), rf = simulate_scene(full);
+  std::filesystem::remove(path);
+  REQUIRE(ra.rows.rows() == rb.rows.rows());
+  REQUIRE(ra.rows.cols() == rb.rows.cols());
+  CHECK((ra.rows.array() == rb.rows.array()).all());
+  CHECK(ra.rows.cols() == rf.rows.cols() - 2 * 3);  // two fewer q, η and τ columns
+  CHECK(ra.max_tail_error < 0.05);
+
+  // errors name the scene, the field and the joint or pattern
+  const auto bad = [&](const std::string& locked) {
+    try {
+      (void)simulate_scene(mm_scene(R"({"locked": )" + locked + "}"));
+    } catch (const error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  using Catch::Contains;
+  CHECK_THAT(bad(R"({"base_x": 0})"), Contains("scene 'mobile-manipulator-circle': field 'locked': ") &&
+                                          Contains("'base_x' belongs to the constraint (differential_drive)"));
+  CHECK_THAT(bad(R"({"hand_*": 0})"), Contains("field 'locked'") && Contains("'hand_*' matches no movable joint"));
+  CHECK_THAT(bad(R"({"head_pan_joint": "up"})"),
+             Contains("scene 'mobile-manipulator-circle', field 'locked': 'head_pan_joint': expected a finite position"));
+  CHECK_THAT(error_of([] { paper_scene(R"("locked": {"joint5": 0})"); }),
+             Contains("scene 'p': field 'locked': paper5 runs on its 5-joint chains"));
 }

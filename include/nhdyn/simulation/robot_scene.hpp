@@ -145,7 +145,7 @@ inline scene_setup setup_scene(const run_spec& s) {
     out.eta_names = c.eta_names(out.plant.joint_names());
     return apply_terms(out);
   }
-  const io::robot_model r = load_scene_robot(s.robot);
+  const io::robot_model r = io::lock_robot(load_scene_robot(s.robot), s.locked, where + "field 'locked': ");
   const int n = r.model.dof(), m = n - r.k();
   out.robot = r.name;
   detail::check_reference(s, n);

@@ -5,7 +5,8 @@
 /// numbers (paper5.md). Unknown fields are errors naming the field ("scene 'x': unknown
 /// field 'controller.K2'"), so a typo never falls back to a default silently.
 ///
-///     scene  = {"name", "description", "robot": "paper5" | robot file, "task": {"frame", "point"},
+///     scene  = {"name", "description", "robot": "paper5" | robot file, "locked": {"JOINT or GLOB": q},
+///               "task": {"frame", "point"},
 ///               "plant": factors and terms, "model": factors and terms,
 ///               "controller": {...}, "reference": {...}, "initial": {"q", "eta"},
 ///               "integrator": {...}, "duration", "sampling": {...}, "noise": {...},
@@ -183,7 +184,7 @@ inline run_spec parse_run(const json& j, const std::vector<std::filesystem::path
   const std::string name = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : "";
   const std::string where = "scene '" + (name.empty() ? "(unnamed)" : name) + "': ";
   const detail::object o(j, where, "",
-                         {"name", "description", "robot", "task", "plant", "model", "controller", "reference",
+                         {"name", "description", "robot", "locked", "task", "plant", "model", "controller", "reference",
                           "initial", "integrator", "duration", "sampling", "noise", "output", "success"});
   run_spec s;
   if (name.empty()) throw input_error(where + "field 'name' (a string) is required");
@@ -216,6 +217,12 @@ inline run_spec parse_run(const json& j, const std::vector<std::filesystem::path
                         ") nor a robot file, URDF or JSON model (looked for " +
                         (looked.empty() ? std::string("nothing: no folder") : looked) + ")");
     }
+  }
+  if (o.has("locked")) {
+    if (paper5)
+      throw input_error(where + "field 'locked': paper5 runs on its 5-joint chains (its task is link 5); hold joints of "
+                                "a robot file, URDF or JSON model (paper5's robot file: examples/robots/paper5.json)");
+    s.locked = io::detail::read_locked(j.at("locked"), io::detail::place{where.substr(0, where.size() - 2)});
   }
   if (!paper5) {
     const auto task = o.sub("task", {"frame", "point"});

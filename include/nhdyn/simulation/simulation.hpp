@@ -82,6 +82,9 @@ struct run_spec : run_options {
   std::vector<std::pair<std::string, double>> plant_mass, model_mass;  ///< mass factors by body name
   std::vector<std::pair<std::string, double>> plant_length, model_length;  ///< joint placement factors by joint name
   double plant_wheel_radius = 1, model_wheel_radius = 1;  ///< factors on the constraint's wheel radius
+  /// Joints held at positions, names or globs (scene field "locked"; io::lock_robot): plant
+  /// and model are the robot without them; q_start, posture_joints name the kept joints.
+  std::vector<std::pair<std::string, double>> locked;
 
   // Which terms of the equations of motion the plant's forward dynamics and the controller's
   // model include (dynamics/terms.hpp; scene fields plant.terms, model.terms, smooth_coulomb).
