@@ -655,6 +655,11 @@ int run(const std::vector<std::string>& args) {
       std::error_code ec;
       const auto p = std::filesystem::absolute(specs[i].robot, ec);
       e["robot"] = !ec && std::filesystem::is_regular_file(p, ec) ? p.string() : specs[i].robot;
+      if (!specs[i].locked.empty()) {  // the scene's "locked": the runs' q has the kept joints
+        nlohmann::ordered_json l = nlohmann::ordered_json::object();
+        for (const auto& [name, x] : specs[i].locked) l[name] = x;
+        e["locked"] = l;
+      }
     }
     e["success"] = r.success;
     e["max_tail_error"] = std::isfinite(r.max_tail_error) ? nlohmann::ordered_json(r.max_tail_error) : nullptr;

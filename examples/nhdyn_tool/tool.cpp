@@ -63,7 +63,6 @@ bool is_urdf(const std::string& spec) {
   return ext == ".urdf";
 }
 
-/// Whether MODEL is a robot file: a JSON object with a "urdf" key.
 bool is_robot_file(const std::string& spec) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(spec, ec)) return false;

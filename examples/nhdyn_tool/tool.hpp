@@ -109,6 +109,8 @@ std::optional<nhdyn::friction_fn> friction_of(const Model& model, const nhdyn::t
 
 /// Whether MODEL names a URDF file (its extension is .urdf, any case).
 bool is_urdf(const std::string& spec);
+/// Whether MODEL names a robot file (a JSON object with a "urdf" key).
+bool is_robot_file(const std::string& spec);
 /// load_model, URDF files (*.urdf) and robot files (JSON with a "urdf" key); `strict`: a non-physical inertia in a URDF is an error
 /// instead of a warning on stderr; `locks`: joints held at positions (names or globs,
 /// nhdyn::lock), for every model (a DH chain with joints held, by --lock or its file's
@@ -148,12 +150,13 @@ inline constexpr std::string_view terms_help =
 )";
 
 /// `nhdyn view`'s page of an `nhdyn simulate` folder (view.cpp): the runs' CSVs in
-/// summary.json's order (at most max_runs), the robot `model` (or, when empty, summary.json's
-/// "robot"), meshes through package_paths; writes `out` (empty: run_dir/view.html) and returns
-/// its path. Throws nhdyn::error naming the file at fault.
+/// summary.json's order (at most max_runs), the robot `model` with `locks` held (or, when
+/// `model` is empty, summary.json's "robot" and "locked"), meshes through package_paths;
+/// writes `out` (empty: run_dir/view.html) and returns its path. Throws nhdyn::error naming
+/// the file at fault.
 std::filesystem::path write_view_page(const std::filesystem::path& run_dir, const std::string& model,
                                       const std::filesystem::path& out, const std::vector<std::string>& package_paths,
-                                      int max_runs = 40);
+                                      int max_runs = 40, const std::vector<std::pair<std::string, double>>& locks = {});
 
 /// Where the tool's shipped data lives: `share/nhdyn` beside the folder of the running
 /// `nhdyn` (its `bin/`), as `cmake --install` and the build tree (`build/bin/nhdyn`,

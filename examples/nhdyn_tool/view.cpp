@@ -12,7 +12,9 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <Eigen/Geometry>
 #include <nhdyn/io/json.hpp>
+#include <nhdyn/model/tree.hpp>
 #include <set>
 #include <sstream>
 
@@ -21,30 +23,34 @@
 namespace nhdyn_tool {
 
 namespace {
-constexpr std::string_view usage = R"(nhdyn view --model MODEL [--q Q1,Q2,...] [--out PAGE.html] [--package-path DIR]...
-nhdyn view RUN_DIR [--model MODEL] [--out PAGE.html] [--package-path DIR]... [--max-runs N]
+constexpr std::string_view usage = R"(nhdyn view --model MODEL [--lock L] [--q Q1,Q2,...] [--out PAGE.html] [--package-path DIR]...
+nhdyn view RUN_DIR [--model MODEL [--lock L]] [--out PAGE.html] [--package-path DIR]... [--max-runs N]
   Writes one self-contained HTML page (no server, nothing fetched when it is opened: the
   JavaScript, the URDF, its meshes and the runs are inside it) and prints its path. The page
   shows the robot from its URDF, the floor, the base's trace, the task path and its reference,
   a time slider with play/pause and speed, q and eta at the cursor, plots of the tracking
   error and tau with a cursor, a study's runs listed or overlaid; orbit, pan, zoom, follow
   the base (docs/tool.md).
-  MODEL: a URDF file, a robot file, or paper5 (its shipped URDF). DH presets and JSON models
-  have no URDF: write one with scripts/dh_to_urdf.py.
+  MODEL: a URDF file, a robot file, paper5 (its shipped robot file), or a DH model (a preset
+  or a JSON model), drawn as rods between its frames and a drum at each joint.
   --model MODEL alone: one pose, q from --q (comma-separated, `nhdyn model` order; default
     zeros). Default page: MODEL's name .html in the current folder.
+  --lock 'NAME=POS,...': the joints held, as the other subcommands take it (q then has the
+    other joints).
   RUN_DIR: an `nhdyn simulate` output folder: every <run>.csv in it (summary.json's order),
-    the robot from summary.json (or --model). Default page: RUN_DIR/view.html.
+    the robot (and its scene's locked joints) from summary.json, or --model and --lock.
+    Default page: RUN_DIR/view.html.
   --package-path DIR: where package://PKG/... meshes are (DIR/PKG/... or, when DIR is named
     PKG, DIR/...); repeatable. Relative mesh paths are read from the URDF's folder. A mesh
     that does not resolve is drawn as a stand-in box, with a notice on the page and here.
   --max-runs N: at most N runs of a study on the page (default 40).
 )";
 
-/// The robot of a page: its URDF file and what the page needs beside it.
+/// The robot of a page: its URDF (a file, or the text of one) and what the page needs beside it.
 struct page_robot {
   std::string name;
   std::filesystem::path urdf;
+  std::string urdf_text;  ///< when not empty, the URDF (a DH model's rods, stick_urdf), not the file
   std::vector<std::string> joints;  ///< q's names, nhdyn's order
   bool planar = false;              ///< q starts with base_x, base_y, base_yaw
   std::vector<std::string> base_joints;
@@ -52,13 +58,78 @@ struct page_robot {
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
 };
 
-page_robot robot_of(const std::string& spec) {
+std::string num(double x) { return nhdyn::io::format_number(x); }
+std::string xyz(const Eigen::Vector3d& v) { return num(v.x()) + " " + num(v.y()) + " " + num(v.z()); }
+
+/// URDF's roll, pitch, yaw of R = Rz(yaw)·Ry(pitch)·Rx(roll).
+Eigen::Vector3d rpy(const Eigen::Matrix3d& R) {
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  if (std::abs(std::cos(pitch)) > 1e-9) return {std::atan2(R(2, 1), R(2, 2)), pitch, std::atan2(R(1, 0), R(0, 0))};
+  return {0.0, pitch, std::atan2(-R(0, 1), R(1, 1))};  // gimbal lock: roll folded into yaw
+}
+
+/// A URDF <visual> cylinder of radius r from a to b (its axis, z, turned onto b − a).
+std::string rod(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double r, const char* material) {
+  const Eigen::Vector3d d = b - a;
+  const double length = d.norm();
+  if (!(length > 1e-9)) return "";
+  const Eigen::Matrix3d R = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), d / length).toRotationMatrix();
+  return "    <visual><origin xyz=\"" + xyz((a + b) / 2) + "\" rpy=\"" + xyz(rpy(R)) + "\"/><geometry><cylinder radius=\"" +
+         num(r) + "\" length=\"" + num(length) + "\"/></geometry><material name=\"" + material + "\"/></visual>\n";
+}
+
+/// A URDF of the tree t drawn as its frames joined: a rod from each body's frame to each of
+/// its children's joint frames and from the joint frame to the body frame, a drum along each
+/// joint's axis (as the Robotics Toolbox draws a DH robot). Body NAME becomes two links,
+/// NAME_joint_frame (the moved joint frame) and NAME (the body frame, behind a fixed joint
+/// X_JB), so that each body's pose on the page is nhdyn's body frame. Sizes follow the
+/// robot's longest rod.
+std::string stick_urdf(const nhdyn::tree<double>& t) {
+  const auto& B = t.bodies();
+  double longest = 0;
+  for (const auto& b : B) longest = std::max({longest, b.p_PJ.norm(), b.p_JB.norm()});
+  const double s = std::max(longest, 0.05), r = 0.06 * s;
+  std::vector<std::string> children(B.size() + 1);  // the rods of each body (0: the root) to its children
+  for (const auto& b : B) children[std::size_t(b.parent + 1)] += rod(Eigen::Vector3d::Zero(), b.p_PJ, r, "rod");
+  std::string u = "<?xml version=\"1.0\"?>\n<robot name=\"" + t.name() + "\">\n" +
+                  "  <material name=\"rod\"><color rgba=\"0.62 0.66 0.72 1\"/></material>\n" +
+                  "  <material name=\"joint\"><color rgba=\"0.93 0.55 0.15 1\"/></material>\n";
+  u += "  <link name=\"" + t.root_name() + "\">\n" + children[0] + "  </link>\n";
+  for (std::size_t i = 0; i < B.size(); ++i) {
+    const auto& b = B[i];
+    const std::string parent = b.parent < 0 ? t.root_name() : B[std::size_t(b.parent)].name, jf = b.name + "_joint_frame";
+    const bool revolute = b.joint == nhdyn::joint_type::revolute;
+    u += "  <joint name=\"" + b.joint_name + "\" type=\"" + (revolute ? "continuous" : "prismatic") + "\">\n    <parent link=\"" +
+         parent + "\"/><child link=\"" + jf + "\"/>\n    <origin xyz=\"" + xyz(b.p_PJ) + "\" rpy=\"" + xyz(rpy(b.R_PJ)) +
+         "\"/><axis xyz=\"" + xyz(b.axis) + "\"/>\n" +
+         (revolute ? "" : "    <limit lower=\"-1e9\" upper=\"1e9\" effort=\"1e9\" velocity=\"1e9\"/>\n") + "  </joint>\n";
+    const Eigen::Vector3d half = b.axis * (revolute ? 0.15 : 0.3) * s;
+    u += "  <link name=\"" + jf + "\">\n" + rod(-half, half, (revolute ? 2.0 : 1.4) * r, "joint") +
+         rod(Eigen::Vector3d::Zero(), b.p_JB, r, "rod") + "  </link>\n";
+    u += "  <joint name=\"" + b.name + "_fixed\" type=\"fixed\">\n    <parent link=\"" + jf + "\"/><child link=\"" + b.name +
+         "\"/>\n    <origin xyz=\"" + xyz(b.p_JB) + "\" rpy=\"" + xyz(rpy(b.R_JB)) + "\"/>\n  </joint>\n";
+    u += "  <link name=\"" + b.name + "\">\n" + children[i + 1] + "  </link>\n";
+  }
+  return u + "</robot>\n";
+}
+
+page_robot robot_of(const std::string& spec, const std::vector<std::pair<std::string, double>>& locks = {}) {
   page_robot r;
-  if (spec == "paper5") return robot_of((data_dir() / "robots" / "paper5.json").string());  // the preset's robot file
-  const any_model a = load_any_model(spec);
-  if (!a.tree)
-    throw nhdyn::model_error("nhdyn view: '" + spec + "' is a DH model, which has no URDF to draw: write one with "
-                             "scripts/dh_to_urdf.py and view that");
+  if (spec == "paper5") return robot_of((data_dir() / "robots" / "paper5.json").string(), locks);  // the preset's robot file
+  const any_model a = load_any_model(spec, false, locks);
+  if (!is_urdf(spec) && !is_robot_file(spec)) {  // a DH model: its full chain's frames joined (the page holds locked joints)
+    const auto m = load_model(spec);
+    const auto t = nhdyn::as_tree(m.chain);
+    r.name = a.name(), r.locked = a.locked, r.urdf_text = stick_urdf(t);
+    r.joints = a.tree ? a.tree->joint_names() : t.joint_names();
+    if (t.gravity().norm() > 0) r.up = -t.gravity().normalized();
+    if (m.constraint) {  // the base's trace from its x, y and heading joints
+      const auto names = t.joint_names();
+      r.base_joints = {names[std::size_t(m.constraint->x)], names[std::size_t(m.constraint->y)],
+                       names[std::size_t(m.constraint->heading)]};
+    }
+    return r;
+  }
   r.name = a.name(), r.joints = a.tree->joint_names(), r.locked = a.locked;
   if (a.tree->gravity().norm() > 0) r.up = -a.tree->gravity().normalized();
   if (is_urdf(spec)) {
@@ -327,7 +398,7 @@ std::string page_of(const ordered_json& data) {
 }
 
 ordered_json robot_json(const page_robot& r, const std::vector<std::string>& package_paths, std::vector<std::string>& missing) {
-  const std::string urdf_text = read_file(r.urdf);
+  const std::string urdf_text = r.urdf_text.empty() ? read_file(r.urdf) : r.urdf_text;
   auto [meshes, miss] = embed_meshes(urdf_text, r.urdf, package_paths);
   missing = miss;
   ordered_json j;
@@ -367,13 +438,14 @@ std::filesystem::path write_page(const page_robot& robot, const std::string& tit
 
 std::filesystem::path write_view_page(const std::filesystem::path& run_dir, const std::string& model,
                                       const std::filesystem::path& out, const std::vector<std::string>& package_paths,
-                                      int max_runs) {
+                                      int max_runs, const std::vector<std::pair<std::string, double>>& locks) {
   namespace fs = std::filesystem;
   std::error_code ec;
   // the runs, in summary.json's order, then any other CSV
   std::vector<std::string> names;
   std::map<std::string, json> summary;
   std::string robot_spec = model;
+  std::vector<std::pair<std::string, double>> held = locks;
   if (fs::is_regular_file(run_dir / "summary.json", ec)) {
     std::ifstream in(run_dir / "summary.json");
     const json s = json::parse(in, nullptr, false);
@@ -382,7 +454,11 @@ std::filesystem::path write_view_page(const std::filesystem::path& run_dir, cons
         if (!r.is_object() || !r.contains("name")) continue;
         names.push_back(r["name"].get<std::string>());
         summary[names.back()] = r;
-        if (robot_spec.empty() && r.contains("robot")) robot_spec = r["robot"].get<std::string>();
+        if (robot_spec.empty() && r.contains("robot")) {
+          robot_spec = r["robot"].get<std::string>();
+          if (r.contains("locked") && r["locked"].is_object())  // the scene's held joints
+            for (auto it = r["locked"].begin(); it != r["locked"].end(); ++it) held.emplace_back(it.key(), it.value().get<double>());
+        }
       }
   }
   std::vector<std::string> csvs;
@@ -404,7 +480,7 @@ std::filesystem::path write_view_page(const std::filesystem::path& run_dir, cons
     std::cerr << "nhdyn view: " << order.size() << " runs, the page holds the first " << max_runs << " (--max-runs)\n";
     order.resize(std::size_t(max_runs));
   }
-  const page_robot robot = robot_of(robot_spec);
+  const page_robot robot = robot_of(robot_spec, held);
   ordered_json runs = ordered_json::array();
   for (const auto& n : order) {
     ordered_json r = run_of(run_dir / (n + ".csv"), n, robot);
@@ -418,9 +494,10 @@ std::filesystem::path write_view_page(const std::filesystem::path& run_dir, cons
 }
 
 namespace {
-std::filesystem::path pose_page(const std::string& model, const std::string& q_text, const std::filesystem::path& out,
+std::filesystem::path pose_page(const std::string& model, const std::vector<std::pair<std::string, double>>& locks,
+                                const std::string& q_text, const std::filesystem::path& out,
                                 const std::vector<std::string>& package_paths) {
-  const page_robot robot = robot_of(model);
+  const page_robot robot = robot_of(model, locks);
   const std::size_t n = robot.joints.size();
   std::vector<double> q(n, 0.0);
   if (!q_text.empty()) {
@@ -444,20 +521,23 @@ std::filesystem::path pose_page(const std::string& model, const std::string& q_t
 
 int run(const std::vector<std::string>& args) {
   CLI::App app;
-  std::string run_dir, model, q, out;
+  std::string run_dir, model, q, out, lock;
   std::vector<std::string> package_paths;
   int max_runs = 40;
   app.add_option("RUN_DIR", run_dir);
   app.add_option("--model", model);
   app.add_option("--q", q);
+  app.add_option("--lock", lock);
   app.add_option("--out", out);
   app.add_option("--package-path", package_paths);
   add_integer_option(app, "--max-runs", max_runs, 1, 100000);
   if (!parse_command_line(app, args, usage)) return 0;
   if (run_dir.empty() && model.empty()) throw usage_error("give RUN_DIR (an nhdyn simulate folder) or --model MODEL");
   if (!run_dir.empty() && !q.empty()) throw usage_error("--q is for a pose (--model alone), not for RUN_DIR's runs");
-  const auto page = run_dir.empty() ? pose_page(model, q, out, package_paths)
-                                    : write_view_page(run_dir, model, out, package_paths, max_runs);
+  if (!lock.empty() && model.empty()) throw usage_error("--lock goes with --model (a run folder's summary.json names its own)");
+  const auto locks = lock.empty() ? std::vector<std::pair<std::string, double>>{} : parse_locks(lock);
+  const auto page = run_dir.empty() ? pose_page(model, locks, q, out, package_paths)
+                                    : write_view_page(run_dir, model, out, package_paths, max_runs, locks);
   std::cout << page.string() << '\n';
   return 0;
 }

@@ -133,13 +133,47 @@ TEST_CASE("view: a URDF whose mesh is missing loads with a notice; a pose of a r
   CHECK(fs::is_regular_file(dir / "mecanum.html"));
   // errors
   CHECK(shell("'" + tool + "' view", dir, "e1").status == 2);
-  const auto dh = shell("'" + tool + "' view --model puma560", dir, "e2");
-  CHECK(dh.status == 1);
-  CHECK(dh.err.find("DH model") != std::string::npos);
   const auto q = shell("'" + tool + "' view --model '" + mecanum + "' --q 1,2", dir, "e3");
   CHECK(q.status == 2);
   CHECK(q.err.find("--q has 2 values") != std::string::npos);
   const auto none = shell("'" + tool + "' view '" + (dir / "no_such_folder").string() + "'", dir, "e4");
   CHECK(none.status == 1);
   CHECK(none.err.find("no_such_folder") != std::string::npos);
+}
+
+TEST_CASE("view: a DH preset drawn as rods between its frames: each body where nhdyn's kinematics puts it") {
+  const auto dir = scratch("dh");
+  // puma560 with joint 6 held (the page sets it from the page's "locked"), q of the other five given
+  const auto v = shell("'" + tool + "' view --model puma560 --lock joint6=0.7 --q 0.3,-0.5,0.4,0.2,0.6 --out '" +
+                           (dir / "puma.html").string() + "'", dir, "view");
+  INFO(v.out << v.err);
+  REQUIRE(v.status == 0);
+  const auto b = shell(browser("'" + (dir / "puma.html").string() + "' --out '" + (dir / "browser").string() + "'"), dir, "browser");
+  INFO(b.out << b.err);
+  REQUIRE(b.status == 0);
+  CHECK(b.out.find("not ok") == std::string::npos);
+  std::ifstream pf(dir / "browser" / "poses.json");
+  const json P = json::parse(pf);
+  REQUIRE(P["joint_names"].get<std::vector<std::string>>() == std::vector<std::string>{"joint1", "joint2", "joint3", "joint4", "joint5"});
+  // the full chain as a tree (as_tree: bodies link1..link6 in DH frames 1..6) at q6 = 0.7
+  const auto t = nhdyn::as_tree(nhdyn::io::load("puma560").chain);
+  const nhdyn::tree_kinematics<double> kin(t);
+  Eigen::VectorXd q(6);
+  q << 0.3, -0.5, 0.4, 0.2, 0.6, 0.7;
+  int bodies = 0;
+  double worst = 0;
+  for (const auto& [link, m] : P["samples"][0]["poses"].items()) {
+    if (link.ends_with("_joint_frame")) continue;  // the moved joint frames the rods hang from
+    const auto X = kin.frame(q, link);
+    for (int c = 0; c < 3; ++c) {
+      for (int r = 0; r < 3; ++r) worst = std::max(worst, std::abs(m[std::size_t(4 * c + r)].get<double>() - X.R(r, c)));
+      worst = std::max(worst, std::abs(m[std::size_t(12 + c)].get<double>() - X.p(c)));
+    }
+    ++bodies;
+  }
+  INFO(bodies << " bodies, largest difference " << worst);
+  CHECK(bodies == 7);  // base, link1..link6
+  CHECK(worst <= 1e-9);
+  std::cout << "view: puma560 drawn from its DH model, " << bodies << " body poses, largest difference from nhdyn's kinematics "
+            << worst << '\n';
 }
