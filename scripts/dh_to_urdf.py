@@ -11,6 +11,11 @@ first factor for i = 1, whose parent is the base link, DH frame 0), its axis is 
 <inertial> sits at Tx(a_i)Rx(alpha_i) com_i with rpy (alpha_i, 0, 0). Revolute DH joints become
 `continuous` (DH rows carry no limits). Gravity is not part of a URDF: the model's is written in
 a comment, and a loader must be given it.
+
+Each link is drawn (<visual>, for `nhdyn view` and other viewers; no effect on the dynamics)
+as the DH parameters place it: a drum along its revolute joint's axis, a rod along x_i for
+a_i and one along the next joint's axis for d_{i+1}; the base link carries the rod of d_1.
+Sizes follow the model's longest a or d.
 """
 import json
 import math
@@ -51,16 +56,33 @@ def xyz(v):
     return " ".join(num(x) for x in v)
 
 
+def rod(start, direction_rpy, length, radius, material, axis):
+    """A <visual> cylinder from `start` to start + length·axis (axis a unit vector, length
+    signed), its own z turned onto the axis by `direction_rpy`."""
+    if abs(length) < 1e-9:
+        return ""
+    centre = [start[k] + axis[k] * length / 2 for k in range(3)]
+    return (f'    <visual>\n      <origin xyz="{xyz(centre)}" rpy="{xyz(direction_rpy)}"/>\n'
+            f'      <geometry><cylinder radius="{num(radius)}" length="{num(abs(length))}"/></geometry>\n'
+            f'      <material name="{material}"/>\n    </visual>\n')
+
+
 def main():
     model = json.load(open(sys.argv[1]))
     links = model["links"]
+    size = max([abs(L["a"]) for L in links] + [abs(L["d"]) for L in links] + [0.05])
+    r = round(0.06 * size, 4)
     g = model.get("gravity", [0, 0, -9.81])
     out = ['<?xml version="1.0"?>',
            f'<!-- {model["name"]}: written by scripts/dh_to_urdf.py from its standard-DH model',
            f'     (examples/models/{model["name"]}.json). Gravity in the base frame: [{xyz(g)}]',
            '     (not part of URDF: load with that gravity). -->',
            f'<robot name="{model["name"]}">',
-           '  <link name="base"/>']
+           '  <material name="rod"><color rgba="0.62 0.66 0.72 1"/></material>',
+           '  <material name="joint"><color rgba="0.93 0.55 0.15 1"/></material>']
+    d1 = links[0]["d"] if links[0]["joint"] == "revolute" else 0.0
+    base_rod = rod([0, 0, 0], [0, 0, 0], d1, r, "rod", [0, 0, 1])
+    out.append('  <link name="base"/>' if not base_rod else f'  <link name="base">\n{base_rod}  </link>')
     prev_a, prev_alpha = 0.0, 0.0
     for i, L in enumerate(links, start=1):
         R = matmul(rot_x(prev_alpha), rot_z(L["theta"]))
@@ -75,10 +97,17 @@ def main():
         Rc = rot_x(alpha)
         pc = [a + c[0], Rc[1][1] * c[1] + Rc[1][2] * c[2], Rc[2][1] * c[1] + Rc[2][2] * c[2]]
         I = L["inertia"]
+        visuals = ""
+        if L["joint"] == "revolute":
+            visuals += rod([0, 0, -1.5 * r], [0, 0, 0], 3 * r, 2 * r, "joint", [0, 0, 1])
+        visuals += rod([0, 0, 0], [0, math.pi / 2, 0], a, r, "rod", [1, 0, 0])
+        if i < len(links) and links[i]["joint"] == "revolute":  # the next joint's d, along its axis
+            visuals += rod([a, 0, 0], [alpha, 0, 0], links[i]["d"], r, "rod", [0, -math.sin(alpha), math.cos(alpha)])
         out.append(f'  <link name="link{i}">\n    <inertial>\n      <origin xyz="{xyz(pc)}" rpy="{num(alpha)} 0 0"/>\n'
                    f'      <mass value="{num(L["mass"])}"/>\n'
                    f'      <inertia ixx="{num(I[0][0])}" ixy="{num(I[0][1])}" ixz="{num(I[0][2])}" '
-                   f'iyy="{num(I[1][1])}" iyz="{num(I[1][2])}" izz="{num(I[2][2])}"/>\n    </inertial>\n  </link>')
+                   f'iyy="{num(I[1][1])}" iyz="{num(I[1][2])}" izz="{num(I[2][2])}"/>\n    </inertial>\n'
+                   f'{visuals}  </link>')
         prev_a, prev_alpha = a, alpha
     out.append("</robot>")
     print("\n".join(out))
