@@ -50,6 +50,7 @@ struct model {
   std::optional<nhdyn::base_constraint> tree_constraint;
   std::vector<std::string> joints, eta, tau;
   std::vector<std::pair<std::string, double>> locked;  ///< joints held (load's locked=), full q order
+  std::vector<std::pair<std::string, double>> requested;  ///< load's locked= as given (the file's own "locked" not included)
   int dof() const { return int(joints.size()); }
   int m() const { return int(eta.size()); }
   bool constrained() const { return chain_constraint || tree_constraint; }
@@ -94,6 +95,7 @@ void take_robot(model& out, nhdyn::io::robot_model r) {
 std::shared_ptr<model> load(const std::string& spec, bool strict, const std::map<std::string, double>& locked) {
   auto out = std::make_shared<model>();
   out->source = spec;
+  out->requested.assign(locked.begin(), locked.end());
   const bool urdf = ends_with_urdf(spec), robot = !urdf && is_robot_file(spec);
   const std::vector<std::pair<std::string, double>> locks(locked.begin(), locked.end());
   if (urdf || robot) {
@@ -717,6 +719,14 @@ py::dict result_dict(const nhdyn::run_spec& spec, nhdyn::run_result& r) {
   d["steps"] = r.steps;
   d["cpu_time_s"] = r.cpu_time_s;
   d["seed"] = spec.run_seed ? py::object(py::int_(*spec.run_seed)) : py::object(py::none());
+  {  // the robot as nhdyn.view finds it again: a preset's name, or the file's absolute path
+    std::error_code ec;
+    const auto p = std::filesystem::absolute(spec.robot, ec);
+    d["robot"] = !ec && std::filesystem::is_regular_file(p, ec) ? p.string() : spec.robot;
+    py::dict held;
+    for (const auto& [name, x] : spec.locked) held[py::str(name)] = x;
+    d["locked"] = held;
+  }
   d["columns"] = r.columns;
   const auto rows = r.rows.rows(), cols = r.rows.cols();
   py::array_t<double> data({py::ssize_t(rows), py::ssize_t(cols)});
@@ -763,6 +773,164 @@ py::dict result_dict(const nhdyn::run_spec& spec, nhdyn::run_result& r) {
     d["err"] = col(int(cols) - 1);
   }
   return d;
+}
+
+// ---------------------------------------------------------------------------------------
+// view: the page of `nhdyn view`, written by the nhdyn tool (one page writer for both)
+// ---------------------------------------------------------------------------------------
+
+/// A page nhdyn.view wrote; Jupyter shows it inline (_repr_html_: the page in an iframe).
+struct page {
+  std::string path;
+};
+
+/// The nhdyn tool: $NHDYN_TOOL, else the build's or the installed one this module was built
+/// with, else `nhdyn` on the PATH.
+std::string tool_path() {
+  if (const char* e = std::getenv("NHDYN_TOOL"); e && *e) return e;
+  std::error_code ec;
+#ifdef NHDYN_PY_TOOL_BUILD
+  if (std::filesystem::is_regular_file(NHDYN_PY_TOOL_BUILD, ec)) return NHDYN_PY_TOOL_BUILD;
+#endif
+#ifdef NHDYN_PY_TOOL_INSTALL
+  if (std::filesystem::is_regular_file(NHDYN_PY_TOOL_INSTALL, ec)) return NHDYN_PY_TOOL_INSTALL;
+#endif
+  return "nhdyn";
+}
+
+/// Runs `nhdyn view ARGS` and returns the page it printed; the tool's message (naming the
+/// file, joint or field at fault) becomes an InputError.
+page run_view(std::vector<std::string> args) {
+  args.insert(args.begin(), {tool_path(), "view"});
+  py::object r;
+  try {
+    r = py::module_::import("subprocess").attr("run")(args, py::arg("capture_output") = true, py::arg("text") = true);
+  } catch (py::error_already_set& e) {
+    if (!e.matches(PyExc_OSError)) throw;
+    throw nhdyn::input_error("nhdyn.view: cannot run the nhdyn tool '" + args[0] + "' (" + std::string(py::str(e.value())) +
+                             "): build or install it, or set NHDYN_TOOL to its path");
+  }
+  const auto out = r.attr("stdout").cast<std::string>(), err = r.attr("stderr").cast<std::string>();
+  if (r.attr("returncode").cast<int>() != 0) {
+    std::string msg = err;
+    while (!msg.empty() && msg.back() == '\n') msg.pop_back();
+    throw nhdyn::input_error(msg.empty() ? "nhdyn.view: the nhdyn tool failed" : msg);
+  }
+  if (!err.empty()) py::module_::import("sys").attr("stderr").attr("write")(err);  // notices: meshes not found
+  std::string path = out.substr(0, out.find('\n'));
+  return {std::filesystem::absolute(path).string()};
+}
+
+/// The runs of nhdyn.simulate (a dict or a list of them) written as `nhdyn simulate` writes a
+/// folder: <name>.csv (the columns, every number in its shortest round-trip form) and
+/// summary.json (name, success, robot, locked).
+void write_runs(const std::vector<py::dict>& runs, const std::filesystem::path& dir) {
+  nhdyn::io::ordered_json summary = {{"runs", nhdyn::io::ordered_json::array()}};
+  for (const auto& d : runs) {
+    for (const char* k : {"name", "columns", "data", "robot"})
+      if (!d.contains(k)) throw nhdyn::input_error(std::string("nhdyn.view: a run has no '") + k + "': give nhdyn.simulate's results");
+    const auto name = d["name"].cast<std::string>();
+    const auto columns = d["columns"].cast<std::vector<std::string>>();
+    const auto data = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(d["data"]);
+    if (!data || data.ndim() != 2 || data.shape(1) != py::ssize_t(columns.size()))
+      throw nhdyn::input_error("nhdyn.view: run '" + name + "': 'data' is not a rows x " + std::to_string(columns.size()) + " array");
+    if (name.empty() || name.find_first_of("/\\") != std::string::npos)
+      throw nhdyn::input_error("nhdyn.view: run name '" + name + "' cannot name a file");
+    std::ofstream csv(dir / (name + ".csv"), std::ios::binary);
+    for (std::size_t j = 0; j < columns.size(); ++j) csv << (j ? "," : "") << columns[j];
+    csv << '\n';
+    const double* x = data.data();
+    for (py::ssize_t i = 0; i < data.shape(0); ++i) {
+      for (py::ssize_t j = 0; j < data.shape(1); ++j) csv << (j ? "," : "") << nhdyn::io::format_number(x[i * data.shape(1) + j]);
+      csv << '\n';
+    }
+    nhdyn::io::ordered_json e = {{"name", name}, {"robot", d["robot"].cast<std::string>()}};
+    if (d.contains("success")) e["success"] = d["success"].cast<bool>();
+    if (d.contains("locked") && py::len(d["locked"]) > 0) {
+      e["locked"] = nhdyn::io::ordered_json::object();
+      for (const auto& [k, v] : d["locked"].cast<py::dict>()) e["locked"][k.cast<std::string>()] = v.cast<double>();
+    }
+    summary["runs"].push_back(e);
+  }
+  std::ofstream(dir / "summary.json") << summary.dump(1);
+}
+
+/// nhdyn.view(what, path, q, package_path, max_runs): see its docstring.
+page view(const py::object& what, const py::object& path, const py::object& q, const std::vector<std::string>& package_path,
+          int max_runs) {
+  std::vector<std::string> args;
+  const auto locks_arg = [](const std::vector<std::pair<std::string, double>>& locks) {
+    std::string s;
+    for (const auto& [name, x] : locks) s += (s.empty() ? "" : ",") + name + "=" + nhdyn::io::format_number(x);
+    return s;
+  };
+  std::vector<py::dict> runs;
+  if (py::isinstance<py::dict>(what)) {
+    runs.push_back(what.cast<py::dict>());
+  } else if (py::isinstance<py::list>(what) || py::isinstance<py::tuple>(what)) {
+    for (const auto& r : what) {
+      if (!py::isinstance<py::dict>(r)) throw py::type_error("nhdyn.view: a list must hold nhdyn.simulate's runs (dicts)");
+      runs.push_back(r.cast<py::dict>());
+    }
+    if (runs.empty()) throw nhdyn::input_error("nhdyn.view: no runs in the list");
+  } else if (py::isinstance<model>(what)) {
+    const auto& m = what.cast<const model&>();
+    args = {"--model", m.source};
+    if (!m.requested.empty()) args.insert(args.end(), {"--lock", locks_arg(m.requested)});
+  } else if (py::isinstance<py::str>(what) || py::isinstance(what, py::module_::import("pathlib").attr("PurePath"))) {
+    const std::string s = py::str(what);
+    std::error_code ec;
+    if (std::filesystem::is_directory(s, ec)) args = {s, "--max-runs", std::to_string(max_runs)};
+    else args = {"--model", s};
+  } else {
+    throw py::type_error("nhdyn.view: expected a Model, a model spec or run folder (str), or nhdyn.simulate's runs, not " +
+                         std::string(py::str(what.get_type().attr("__name__"))));
+  }
+  if (!q.is_none()) {
+    if (args.empty() || args[0] != "--model") throw nhdyn::input_error("nhdyn.view: q= is for a model's pose, not for runs");
+    std::string s;
+    for (double x : q.cast<std::vector<double>>()) s += (s.empty() ? "" : ",") + nhdyn::io::format_number(x);
+    args.insert(args.end(), {"--q", s});
+  }
+  for (const auto& p : package_path) args.insert(args.end(), {"--package-path", p});
+  std::string out = path.is_none() ? std::string() : std::string(py::str(path));
+  if (runs.empty()) {
+    if (!out.empty()) args.insert(args.end(), {"--out", out});
+    return run_view(args);
+  }
+  // runs: a scratch folder as `nhdyn simulate` writes one, the page where asked (default:
+  // <first run's name>.html in the current folder)
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(py::module_::import("tempfile").attr("mkdtemp")(py::arg("prefix") = "nhdyn_view_").cast<std::string>());
+  try {
+    write_runs(runs, dir);
+    if (out.empty()) out = runs[0]["name"].cast<std::string>() + ".html";
+    args.insert(args.begin(), dir.string());
+    args.insert(args.end(), {"--out", fs::absolute(out).string(), "--max-runs", std::to_string(max_runs)});
+    page p = run_view(args);
+    fs::remove_all(dir);
+    return p;
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+    throw;
+  }
+}
+
+/// The page in an iframe (srcdoc: the page is self-contained), for Jupyter.
+std::string page_html(const page& p) {
+  std::ifstream f(p.path, std::ios::binary);
+  if (!f) throw nhdyn::input_error("nhdyn.view: cannot read '" + p.path + "'");
+  std::ostringstream s;
+  s << f.rdbuf();
+  std::string escaped;
+  for (char c : s.str()) {
+    if (c == '&') escaped += "&amp;";
+    else if (c == '"') escaped += "&quot;";
+    else escaped += c;
+  }
+  return "<iframe srcdoc=\"" + escaped + "\" style=\"width: 100%; height: 560px; border: 1px solid #ccc\" "
+         "sandbox=\"allow-scripts\" title=\"nhdyn view\"></iframe>";
 }
 
 batch_function not_constrained(const model& m, const char* what) {
@@ -1012,6 +1180,27 @@ states: every tau(q, eta, eta_dot) with q in [q_lo, q_hi], ... lies in [tau_lo, 
 f(q_lo, q_hi, qd_lo, qd_hi, qdd_lo, qdd_hi) -> rne bounds (n entries). `split` bisects the
 box 2^split times (tighter bounds, 2^split evaluations). Batches: one box per row. Raises
 InputError for lo > hi or NaN, NumericalError for a box too wide to bound.)");
+  py::class_<page>(mod, "Page", "A page nhdyn.view wrote: its path; shown inline in Jupyter (an iframe of the page).")
+      .def_readonly("path", &page::path, "the page's absolute path")
+      .def("__fspath__", [](const page& p) { return p.path; })
+      .def("__str__", [](const page& p) { return p.path; })
+      .def("__repr__", [](const page& p) { return "nhdyn.Page('" + p.path + "')"; })
+      .def("_repr_html_", &page_html, "the page in an iframe (its srcdoc), for Jupyter");
+  mod.def("view", &view, py::arg("what"), py::arg("path") = py::none(), py::arg("q") = py::none(),
+          py::arg("package_path") = std::vector<std::string>{}, py::arg("max_runs") = 40,
+          R"(view(what, path=None, q=None, package_path=[], max_runs=40) -> Page
+
+One self-contained HTML page of a robot or of its runs (three.js; nothing is fetched when it
+is opened), written by the nhdyn tool's `view` (docs/tool.md): the robot from its URDF (a DH
+model as rods between its frames), the floor, the base's trace, the task path and its
+reference, a time slider, q and eta at the cursor, plots of the error and tau; a study's
+runs listed or overlaid. what: a Model (its spec and locked=), a model spec (str), an
+`nhdyn simulate` output folder, or nhdyn.simulate's runs (a dict or a list of them). path:
+where the page goes (default: the model's or first run's name .html in the current folder,
+or RUN_DIR/view.html). q: a pose for a model (nhdyn order; default zeros). package_path:
+folders for package:// meshes. Returns a Page (str() is its path); in Jupyter the page shows
+inline. The tool is $NHDYN_TOOL, the one built or installed with this module, or `nhdyn` on
+the PATH. Raises InputError with the tool's message (the file, joint or field at fault).)");
   mod.def("simulate",
           [](const py::object& scene, int threads, const py::object& controller) {
             const std::string module_file = py::module_::import("nhdyn").attr("__file__").cast<std::string>();

@@ -502,6 +502,71 @@ def test_locked_dh_model_from_python():
         nhdyn.load("paper5", locked={"joint1": 0.0})
 
 
+def page_data(path):
+    """The data a page of nhdyn view carries (its line window.NHDYN_DATA = {...};)."""
+    text = open(path, encoding="utf-8").read()
+    key = "window.NHDYN_DATA = "
+    return json.JSONDecoder().raw_decode(text, text.index(key) + len(key))[0]
+
+
+def view_or_skip(*args, **kwargs):
+    """nhdyn.view, skipped where the page cannot be made here (no page template: node was
+    missing at build time; no tool; no URDF support)."""
+    try:
+        return nhdyn.view(*args, **kwargs)
+    except nhdyn.InputError as e:
+        if "template" in str(e) or "cannot run the nhdyn tool" in str(e) or "without URDF support" in str(e):
+            pytest.skip(str(e))
+        raise
+    except nhdyn.ModelError as e:
+        if "template" in str(e) or "without URDF support" in str(e):
+            pytest.skip(str(e))
+        raise
+
+
+def test_view_from_python(tmp_path):
+    """nhdyn.view writes the tool's page of a Model (its pose, its locked joints), of a DH
+    model, and of nhdyn.simulate's runs, whose q reach the page bit for bit; the Page shows
+    inline in Jupyter; errors are named."""
+    path = os.path.join(SOURCE, "examples", "robots", "mecanum_arm.json")
+    m = load_robot_or_skip(path)
+    q = np.linspace(-0.5, 0.5, m.dof) / 3
+    page = view_or_skip(m, tmp_path / "mecanum.html", q=q)
+    assert str(page) == os.fspath(page) == page.path == str(tmp_path / "mecanum.html")
+    d = page_data(page.path)
+    assert d["robot"]["joint_names"] == m.joints
+    assert d["runs"][0]["q"] == [list(q)]
+    html = page._repr_html_()
+    assert html.startswith('<iframe srcdoc="') and "window.NHDYN_DATA" in html and "&quot;" in html
+    # a DH preset with a joint held: drawn from its chain, the held joint in the page's "locked"
+    p = nhdyn.load("puma560", locked={"joint6": 0.7})
+    d = page_data(view_or_skip(p, tmp_path / "puma.html").path)
+    assert d["robot"]["locked"] == {"joint6": 0.7}
+    assert d["robot"]["joint_names"] == p.joints == ["joint1", "joint2", "joint3", "joint4", "joint5"]
+    # runs: paper-circle's first half second, and the mobile manipulator with its head held
+    runs = nhdyn.simulate({"name": "p-short", "duration": 0.5})
+    d = page_data(view_or_skip(runs, tmp_path / "runs.html").path)
+    assert runs[0]["robot"] == "paper5"
+    assert d["runs"][0]["name"] == "p-short"
+    assert d["runs"][0]["q"] == runs[0]["q"].tolist()
+    scene = json.load(open(os.path.join(SOURCE, "examples", "scenes", "mobile-manipulator-circle.json")))
+    scene.update({"robot": os.path.join(SOURCE, "examples", "robots", "mobile_manipulator.json"), "duration": 0.2,
+                  "locked": {"head_*": 0.2}, "initial": {"q": scene["initial"]["q"][:17]},
+                  "success": {"tail_from": 0.1, "max_tail_error": 1}})
+    scene["controller"]["posture_joints"] = [j for j in scene["controller"]["posture_joints"] if not j.startswith("head_")]
+    runs = nhdyn.simulate(scene)
+    assert runs[0]["locked"] == {"head_*": 0.2}
+    d = page_data(view_or_skip(runs[0], tmp_path / "mm.html").path)
+    assert d["robot"]["locked"] == {"head_pan_joint": 0.2, "head_tilt_joint": 0.2}
+    assert d["runs"][0]["q"] == runs[0]["q"].tolist()
+    with pytest.raises(TypeError, match="expected a Model"):
+        nhdyn.view(3)
+    with pytest.raises(nhdyn.InputError, match="nothing_here"):
+        nhdyn.view(str(tmp_path / "nothing_here.urdf"))
+    with pytest.raises(nhdyn.InputError, match="q= is for a model"):
+        nhdyn.view(runs, q=[0.0])
+
+
 def test_terms_from_python():
     """rne(terms=...) and inverse_dynamics(terms=...): the Robotics Toolbox's rne(qn, 1, 1)
     (friction included) on puma560_motors, the tool's --terms numbers, and a robot file whose
