@@ -3,7 +3,8 @@
 // console error and fetches nothing; the world poses of the robot's links that the page
 // computes (three.js and urdf-loader from the URDF text) at three times equal nhdyn's forward
 // kinematics of the run's q at those times (tree_kinematics, 1e-9 m); screenshots at two times
-// differ and the base's trace is drawn; a URDF with a missing mesh loads and shows the notice.
+// differ and the base's trace is drawn; a URDF with a missing mesh loads and shows the notice;
+// a DH preset drawn from its frames; the page of every shipped scene loads without an error.
 // The page's size and load time are printed (measured, not asserted: speed targets belong to
 // benchmarks).
 #include <catch2/catch.hpp>
@@ -176,4 +177,30 @@ TEST_CASE("view: a DH preset drawn as rods between its frames: each body where n
   CHECK(worst <= 1e-9);
   std::cout << "view: puma560 drawn from its DH model, " << bodies << " body poses, largest difference from nhdyn's kinematics "
             << worst << '\n';
+}
+
+TEST_CASE("view: the page of each shipped scene loads in headless chromium with no console error") {
+  // mobile-manipulator-circle is the first test case's; `paper` is the suite of the three
+  // paper scenes; the Monte Carlo study runs 6 of its 1000 runs (a study file naming it)
+  const auto dir = scratch("scenes");
+  const fs::path mc = dir / "mc-6.json";
+  std::ofstream(mc) << R"({"name": "mc-6", "study": {"base": "mobile-manipulator-circle", "set": {"output": {"step": 0.1}},
+    "monte_carlo": {"runs": 6, "seed": 2026}, "factors": [
+      {"name": "payload", "path": "/plant/mass_factor/arm_7_link", "distribution": {"uniform": [1.0, 2.0]}}]}})";
+  const std::vector<std::string> scenes{"paper-circle", "paper-factorial", "paper-noise", "mecanum-sideways-circle",
+                                        "puma560-line", "puma560-computed-torque", mc.string()};
+  for (const auto& scene : scenes) {
+    const std::string tag = fs::path(scene).stem().string();
+    const auto out = dir / tag;
+    const auto sim = shell("'" + tool + "' simulate '" + scene + "' --out '" + out.string() + "' --no-plots --html", dir, tag + "-sim");
+    INFO(scene << ": " << sim.out << sim.err);
+    REQUIRE(fs::is_regular_file(out / "view.html"));
+    const auto b = shell(browser("'" + (out / "view.html").string() + "' --out '" + (out / "browser").string() + "'"), dir, tag + "-browser");
+    INFO(b.out << b.err);
+    CHECK(b.status == 0);
+    CHECK(b.out.find("not ok") == std::string::npos);
+    CHECK(b.out.find("ok - no console error and no page error") != std::string::npos);
+    std::cout << "view: " << scene << ": " << fs::file_size(out / "view.html") / 1000 << " kB, "
+              << b.out.substr(b.out.find("load: "), b.out.find('\n', b.out.find("load: ")) - b.out.find("load: ")) << '\n';
+  }
 }
