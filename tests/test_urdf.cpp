@@ -413,3 +413,22 @@ TEST_CASE("robot file errors name the file and the field", "[urdf][robot_file][e
   // a fixed base: the URDF's joints only
   CHECK(io::parse_robot_file(R"({"urdf": "../urdf/mobile_manipulator.urdf"})", dir).model.dof() == 16);
 }
+
+TEST_CASE("CRBA far from the origin: a planar base's M does not depend on where the base stands", "[urdf][crba]") {
+  // M(q) of a robot on a planar base is invariant under the base's translation (a physics
+  // invariant): 10 km away it must keep its digits. The kernel works in world axes about the
+  // bodies' mean origin, not about the world origin, for this.
+  const auto r = io::load_robot_file(std::string(NHDYN_SOURCE_DIR) + "/examples/robots/mobile_manipulator.json");
+  const auto M = mass_matrix(r.model);
+  std::mt19937_64 rng(71);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int s = 0; s < 5; ++s) {
+    VectorXd q = VectorXd::NullaryExpr(r.model.dof(), [&] { return u(rng); });
+    q(0) = q(1) = 0;
+    const MatrixXd M0 = M(q);
+    q(0) = 1e4, q(1) = -7e3;
+    const MatrixXd Mfar = M(q);
+    CHECK((Mfar - M0).norm() <= 1e-12 * M0.norm());
+    CHECK((Mfar - reference::crba<double>(r.model, q)).norm() <= 1e-12 * M0.norm());
+  }
+}
