@@ -112,113 +112,54 @@ void tree_rne_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, cons
     tree_rne_kernel_impl<Gravity, Velocity, T>(L, g, q, qd, qdd, tau);
 }
 
-/// The composite-rigid-body algorithm on the kernel constants (RBDA Table 6.2), in world axes:
-/// every body's inertia is carried once to the root frame's axes, about one point c₀;
-/// composite inertias are then sums, and each entry H(i, j) = S_jᵀ (I^c_i S_i) is a 6-term
-/// dot product of world-axes motion and force vectors, with no transform on the walk from i
-/// to the root. c₀ is the origin of the trunk's last body (the trunk: the bodies from the root
-/// down to the first that branches; a mobile base's yaw body), and the positions below it are
-/// summed from it, so that a robot standing 10 km from the world origin keeps its digits
-/// (tests/test_urdf.cpp). One workspace allocation and the returned matrix.
+/// The composite-rigid-body algorithm on the kernel constants (RBDA Table 6.2 in 3-vector
+/// form: a composite body's m, h, I_o are carried to the parent's frame).
 template <class T, class Q>
-Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> tree_crba_kernel_impl(const std::vector<tree_link<T>>& L, const Q& q) {
+Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> tree_crba_kernel(const std::vector<tree_link<T>>& L, const Q& q) {
   const int n = static_cast<int>(L.size());
-  struct body_w {
-    mat3<T> R, I;  // K_i's axes in the root frame; the composite's rotational inertia about c₀
-    vec3<T> p, h;  // K_i's origin − c₀; the composite's first moment about c₀ (m (c − c₀))
-    vec3<T> w, v;  // S_i about c₀: the joint's axis ω and the velocity of c₀ it gives
-    T m;
-    int children;
-  };
-  std::vector<body_w> B(static_cast<std::size_t>(n));
-  for (auto& b : B) b.children = 0;
-  for (int i = 0; i < n; ++i)
-    if (L[i].parent >= 0) ++B[std::size_t(L[i].parent)].children;
-  // the trunk 0 … a: body 0 the only root body, each the next one's only parent
-  int a = -1;
-  if (n > 0 && L[0].parent < 0) {
-    a = 0;
-    while (a + 1 < n && B[std::size_t(a)].children == 1 && L[a + 1].parent == a) ++a;
-    for (int i = a + 1; i < n && a >= 0; ++i)
-      if (L[i].parent < 0) a = -1;  // a second root body: no trunk
-  }
-  // placements, root to tip: the trunk's in the root frame, then relative to c₀ = its last
-  // origin (0 without a trunk); below the trunk summed from c₀
+  std::vector<mat3<T>> R(n), Io(n);
+  std::vector<vec3<T>> p(n), h(n);
+  std::vector<T> m(n);
   for (int i = 0; i < n; ++i) {
-    mat3<T> R;
-    vec3<T> p;
-    kernel_placement(L[i], T(q(i)), R, p);
-    auto& b = B[std::size_t(i)];
-    if (L[i].parent < 0) {
-      b.R = R, b.p = p;
-    } else {
-      const auto& P = B[std::size_t(L[i].parent)];
-      b.R = P.R * R, b.p = P.p + P.R * p;
-    }
-    if (i == a) {
-      const vec3<T> c0 = b.p;
-      for (int j = 0; j <= a; ++j) B[std::size_t(j)].p -= c0;
-    }
+    kernel_placement(L[i], T(q(i)), R[i], p[i]);
+    m[i] = L[i].m;
+    h[i] = L[i].h;
+    Io[i] = L[i].Io;
   }
-  // each body about c₀ in world axes: I = R I_o Rᵀ + m(|r|² 1 − r rᵀ) + 2 (r·h_r) 1 − h_r rᵀ − r h_rᵀ
-  // (the parallel axis with the origin moved by r = origin − c₀, h_r = R h), then composites
-  // tip to root by adding
-  for (int i = 0; i < n; ++i) {
-    auto& b = B[std::size_t(i)];
-    const vec3<T>& r = b.p;
-    const vec3<T> z = b.R.col(2);
-    if (L[i].revolute) {
-      b.w = z, b.v = r.cross(z);  // rotation about the axis through the origin: c₀ moves at z × (c₀ − origin)
-    } else {
-      b.w.setZero(), b.v = z;
-    }
-    if (!L[i].has_inertia) {
-      b.m = T(0), b.h.setZero(), b.I.setZero();
-      continue;
-    }
-    const vec3<T> hr = b.R * L[i].h;
-    const T m = L[i].m;
-    b.m = m;
-    b.h = hr + m * r;
-    const vec3<T> mr = m * r + hr;  // −(m r rᵀ + h_r rᵀ + r h_rᵀ) = −(mr + h_r) rᵀ … symmetrised below
-    b.I.noalias() = b.R * L[i].Io * b.R.transpose();
-    b.I.noalias() -= mr * r.transpose();
-    b.I.noalias() -= r * hr.transpose();
-    b.I.diagonal().array() += m * r.squaredNorm() + T(2) * r.dot(hr);
-  }
+  // composite inertias, tip to root: in the parent frame, h' = R h + m p,
+  // I_o' = R I_o Rᵀ − m S(p)² − S(p) S(R h) − S(R h) S(p)   (parallel axis, origin moved by p)
   for (int i = n - 1; i >= 0; --i) {
     const int l = L[i].parent;
     if (l < 0) continue;
-    auto& P = B[std::size_t(l)];
-    const auto& b = B[std::size_t(i)];
-    P.m += b.m, P.h += b.h, P.I += b.I;
+    const vec3<T> hr = R[i] * h[i];
+    const mat3<T> P = spatial::skew(p[i]), Hr = spatial::skew(hr);
+    m[l] += m[i];
+    h[l] += hr + m[i] * p[i];
+    Io[l] += R[i] * Io[i] * R[i].transpose() - m[i] * P * P - P * Hr - Hr * P;
   }
-  Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> H(n, n);
-  H.setZero();
+  Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> H = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>::Zero(n, n);
   for (int i = 0; i < n; ++i) {
-    // F = I^c_i S_i about c₀: f = m v + ω × h, n = I ω + h × v
-    const auto& b = B[std::size_t(i)];
-    const vec3<T> f = b.m * b.v + b.w.cross(b.h), nm = b.I * b.w + b.h.cross(b.v);
-    H(i, i) = b.w.dot(nm) + b.v.dot(f);
-    if (L[i].has_armature) H(i, i) += L[i].Ia;
-    for (int j = L[i].parent; j >= 0; j = L[j].parent) {
-      const auto& a = B[std::size_t(j)];
-      H(i, j) = H(j, i) = a.w.dot(nm) + a.v.dot(f);
+    // F = Ic_i S_i as (moment n about K_i's origin, force f), in K_i
+    vec3<T> f, nm;
+    const vec3<T> z(T(0), T(0), T(1));
+    if (L[i].revolute) {
+      f = z.cross(h[i]);  // ω = z: f = ω × h, n = I_o ω
+      nm = Io[i] * z;
+    } else {
+      f = m[i] * z;  // v = z: f = m v, n = h × v
+      nm = h[i].cross(z);
     }
+    H(i, i) = L[i].revolute ? nm.z() : f.z();
+    for (int j = i; L[j].parent >= 0;) {
+      const vec3<T> fr = R[j] * f;
+      nm = R[j] * nm + p[j].cross(fr);
+      f = fr;
+      j = L[j].parent;
+      H(i, j) = H(j, i) = L[j].revolute ? nm.z() : f.z();
+    }
+    if (L[i].has_armature) H(i, i) += L[i].Ia;
   }
   return H;
-}
-template <class T, class Q>
-NHDYN_FLATTEN Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> tree_crba_kernel_flat(const std::vector<tree_link<T>>& L,
-                                                                                      const Q& q) {
-  return tree_crba_kernel_impl<T>(L, q);
-}
-template <class T, class Q>
-Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> tree_crba_kernel(const std::vector<tree_link<T>>& L, const Q& q) {
-  if constexpr (flatten_kernels<T>)
-    return tree_crba_kernel_flat<T>(L, q);
-  else
-    return tree_crba_kernel_impl<T>(L, q);
 }
 
 }  // namespace detail
