@@ -91,7 +91,10 @@ std::string stick_urdf(const nhdyn::tree<double>& t) {
   const double s = std::max(longest, 0.05), r = 0.06 * s;
   std::vector<std::string> children(B.size() + 1);  // the rods of each body (0: the root) to its children
   for (const auto& b : B) children[std::size_t(b.parent + 1)] += rod(Eigen::Vector3d::Zero(), b.p_PJ, r, "rod");
-  std::string u = "<?xml version=\"1.0\"?>\n<robot name=\"" + t.name() + "\">\n" +
+  std::string name = t.name();  // a JSON model's free text: nothing that would end the attribute
+  for (auto& ch : name)
+    if (ch == '"' || ch == '<' || ch == '>' || ch == '&' || ch == '\'') ch = '_';
+  std::string u = "<?xml version=\"1.0\"?>\n<robot name=\"" + name + "\">\n" +
                   "  <material name=\"rod\"><color rgba=\"0.62 0.66 0.72 1\"/></material>\n" +
                   "  <material name=\"joint\"><color rgba=\"0.93 0.55 0.15 1\"/></material>\n";
   u += "  <link name=\"" + t.root_name() + "\">\n" + children[0] + "  </link>\n";
