@@ -414,6 +414,25 @@ void register_tree(const std::string& model, const nhdyn::tree<double>& t) {
     auto H = M(s.q);
     benchmark::DoNotOptimize(H);
   });
+  {  // into results the caller reuses (evaluate): no allocation at all
+    Eigen::VectorXd v(n);
+    id.evaluate(s.q, s.qd, s.qdd, v);
+    agree(v, tau, 0, "rne/" + model + ": evaluate vs the call");
+    Eigen::MatrixXd Hm(n, n);
+    M.evaluate(s.q, Hm);
+    agree(Eigen::Map<const Eigen::VectorXd>(Hm.data(), n * n), Eigen::Map<const Eigen::VectorXd>(M(s.q).eval().data(), n * n), 0,
+          "crba/" + model + ": evaluate vs the call");
+    add("rne/" + model + "/evaluate", [id, s, v]() mutable {
+      opaque(s.q), opaque(s.qd), opaque(s.qdd);
+      id.evaluate(s.q, s.qd, s.qdd, v);
+      benchmark::DoNotOptimize(v.data());
+    });
+    add("crba/" + model + "/evaluate", [M, s, Hm]() mutable {
+      opaque(s.q);
+      M.evaluate(s.q, Hm);
+      benchmark::DoNotOptimize(Hm.data());
+    });
+  }
   add("crba/" + model + "/reference", [t, s]() mutable {
     opaque(s.q);
     auto H = nhdyn::reference::crba<double>(t, s.q);

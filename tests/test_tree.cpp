@@ -102,6 +102,44 @@ TEST_CASE("tree kernels equal the reference on random trees (double)", "[tree]")
   }
 }
 
+TEST_CASE("tree rne and CRBA into reused storage (evaluate) give the calls' numbers; large trees spill to the heap", "[tree]") {
+  std::mt19937_64 rng(29);
+  for (int n : {3, 16, 200}) {  // 200 bodies: the kernels' scratch beyond its stack part (170 in double)
+    const tree<double> t = nhdyn_ref::random_tree(rng, n);
+    const auto id = rne(t);
+    const auto M = mass_matrix(t);
+    VectorXd v(n);
+    Eigen::MatrixXd H(2, 5);  // resized by the first call, reused by the next
+    for (int s = 0; s < 2; ++s) {
+      const VectorXd q = random_state(rng, n), qd = random_state(rng, n), qdd = random_state(rng, n);
+      INFO("n = " << n);
+      const VectorXd tau = id(q, qd, qdd);
+      CHECK(rel(tau, reference::rne<double>(t, q, qd, qdd)) < 1e-12);
+      CHECK(rel(M(q), reference::crba<double>(t, q)) < 1e-12);
+      id.evaluate(q, qd, qdd, v);
+      CHECK(v == tau);  // bit for bit
+      VectorXd w = qdd;  // v over q̈'s own storage (what the pipeline does with a temporary ξ)
+      id.evaluate(q, qd, w, w);
+      CHECK(w == tau);
+      double buf[256];
+      Eigen::Map<VectorXd> mv(buf, std::min(n, 256));
+      if (n <= 256) {
+        id.evaluate(q, qd, qdd, mv);
+        CHECK(mv == tau);
+      }
+      M.evaluate(q, H);
+      CHECK(H == M(q));
+      // the pipeline form on a temporary ξ (v written over its q̈) = the call
+      const auto f = id(joint_state<double, dynamic>{q, qd, qdd});
+      CHECK(f.v == tau);
+      CHECK(f.q == q);
+    }
+    VectorXd wrong(n + 1);
+    CHECK_THROWS_WITH(id.evaluate(VectorXd::Zero(n), VectorXd::Zero(n), VectorXd::Zero(n), wrong),
+                      Catch::Contains("v") && Catch::Contains(std::to_string(n)));
+  }
+}
+
 TEST_CASE("tree kernels equal the reference for float, duals and intervals", "[tree]") {
   std::mt19937_64 rng(13);
   const tree<double> t = nhdyn_ref::random_tree(rng, 9);

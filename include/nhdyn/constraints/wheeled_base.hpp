@@ -217,7 +217,7 @@ struct elim_eq {
 /// store forwarding in every column of A).
 template <class T>
 struct vec2 {
-  T x_{}, y_{};
+  T x_, y_;  // no initialisers: trivially constructed (the kernel's scratch arrays of frames are not zeroed)
   vec2() = default;
   vec2(T x, T y) : x_(std::move(x)), y_(std::move(y)) {}
   static vec2 Zero() { return {T(0), T(0)}; }
@@ -950,12 +950,13 @@ class wheeled_base {
         const U iw = U(inv_weight_w_[std::size_t(a)]);
         for (int i = 0; i < mw_; ++i) BW[i + a * mw_] = B[i + a * mw_] * iw;
       }
-      for (int i = 0; i < mw_ * mw_; ++i) G[i] = U(0);
-      for (int a = 0; a < pw_; ++a)  // a sum of outer products: the entries' sums run side by side
-        for (int j = 0; j < mw_; ++j)
-          for (int i = j; i < mw_; ++i) G[i + j * mw_] += BW[i + a * mw_] * B[j + a * mw_];
-      for (int j = 0; j < mw_; ++j)
-        for (int i = j + 1; i < mw_; ++i) G[j + i * mw_] = G[i + j * mw_];
+      for (int j = 0; j < mw_; ++j)  // each entry's sum in a register (not through memory)
+        for (int i = j; i < mw_; ++i) {
+          U g(0);
+          for (int a = 0; a < pw_; ++a) g += BW[i + a * mw_] * B[j + a * mw_];
+          G[i + j * mw_] = g;
+          G[j + i * mw_] = g;
+        }
     }
     // B itself by LU (square), B W⁻¹ Bᵀ (symmetric positive definite) by LDLᵀ: refused below
     // a relative pivot of 1e-10 (B) or 1e-20 (BW⁻¹Bᵀ, whose condition number is B's squared)

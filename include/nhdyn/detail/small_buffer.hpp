@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <memory>
 #include <new>
+#include <type_traits>
 #include <vector>
 
 namespace nhdyn::detail {
@@ -26,8 +27,10 @@ class small_buffer {
       data_ = heap_.data();
     } else {
       data_ = std::launder(reinterpret_cast<T*>(&inline_));
-      for (int i = 0; i < n; ++i) ::new (static_cast<void*>(data_ + i)) T;
-      constructed_ = n;
+      if constexpr (!std::is_trivially_default_constructible_v<T> || !std::is_trivially_destructible_v<T>) {
+        for (int i = 0; i < n; ++i) ::new (static_cast<void*>(data_ + i)) T;
+        constructed_ = n;
+      }
     }
   }
   ~small_buffer() { std::destroy_n(data_, constructed_); }

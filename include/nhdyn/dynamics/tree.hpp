@@ -13,10 +13,12 @@
 /// computed once when the function object is built. Velocities and forces are 3-vectors in
 /// those frames (the Luh–Walker–Paul form of the same recursion).
 #include <Eigen/Core>
+#include <algorithm>
 #include <vector>
 
 #include "../detail/attributes.hpp"
 #include "../detail/ldlt.hpp"
+#include "../detail/small_buffer.hpp"
 #include "../functional/values.hpp"
 #include "../model/tree_kernel.hpp"
 #include "../spatial/spatial.hpp"
@@ -36,7 +38,8 @@ void tree_rne_kernel_impl(const std::vector<tree_link<LS>>& L, const vec3<T>& g,
     mat3<T> R;
     vec3<T> w, dw, a, f, m;
   };
-  std::vector<ws> s(static_cast<std::size_t>(n));
+  // on the stack up to 32 KiB of it (170 bodies in double), beyond on the heap; not zeroed
+  small_buffer<ws, dynamic, std::max<std::size_t>(8, 32768 / sizeof(ws))> s(n);
   const vec3<T> zero = vec3<T>::Zero();
   const vec3<T> a0 = Gravity ? vec3<T>(-g) : zero;
   for (int i = 0; i < n; ++i) {
@@ -78,8 +81,9 @@ void tree_rne_kernel_impl(const std::vector<tree_link<LS>>& L, const vec3<T>& g,
   for (int i = n - 1; i >= 0; --i) {
     const auto& k = L[i];
     auto& c = s[i];
-    tau(i) = k.revolute ? c.m.z() : c.f.z();
-    if (k.has_armature) tau(i) += k.Ia * T(qdd(i));
+    T ti = k.revolute ? c.m.z() : c.f.z();
+    if (k.has_armature) ti += k.Ia * T(qdd(i));
+    tau(i) = ti;  // after the read of q̈_i: tau may be q̈'s own storage (tree_rne_fn on an rvalue ξ)
     if (k.parent >= 0) {
       auto& pc = s[k.parent];
       const vec3<T> f = c.R * c.f;
@@ -114,52 +118,60 @@ void tree_rne_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, cons
 
 /// The composite-rigid-body algorithm on the kernel constants (RBDA Table 6.2 in 3-vector
 /// form: a composite body's m, h, I_o are carried to the parent's frame).
-template <class T, class Q>
-Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> tree_crba_kernel(const std::vector<tree_link<T>>& L, const Q& q) {
+template <class T, class Q, class Out>
+void tree_crba_kernel(const std::vector<tree_link<T>>& L, const Q& q, Out& H) {
   const int n = static_cast<int>(L.size());
-  std::vector<mat3<T>> R(n), Io(n);
-  std::vector<vec3<T>> p(n), h(n);
-  std::vector<T> m(n);
+  // each body's placement and composite inertia, in one stack buffer (heap only beyond 32 KiB)
+  struct ws {
+    mat3<T> R, Io;
+    vec3<T> p, h;
+    T m;
+  };
+  small_buffer<ws, dynamic, std::max<std::size_t>(8, 32768 / sizeof(ws))> s(n);
+  const auto R = [&](int i) -> mat3<T>& { return s[i].R; };
+  const auto Io = [&](int i) -> mat3<T>& { return s[i].Io; };
+  const auto p = [&](int i) -> vec3<T>& { return s[i].p; };
+  const auto h = [&](int i) -> vec3<T>& { return s[i].h; };
+  const auto m = [&](int i) -> T& { return s[i].m; };
   for (int i = 0; i < n; ++i) {
-    kernel_placement(L[i], T(q(i)), R[i], p[i]);
-    m[i] = L[i].m;
-    h[i] = L[i].h;
-    Io[i] = L[i].Io;
+    kernel_placement(L[i], T(q(i)), R(i), p(i));
+    m(i) = L[i].m;
+    h(i) = L[i].h;
+    Io(i) = L[i].Io;
   }
   // composite inertias, tip to root: in the parent frame, h' = R h + m p,
   // I_o' = R I_o Rᵀ − m S(p)² − S(p) S(R h) − S(R h) S(p)   (parallel axis, origin moved by p)
   for (int i = n - 1; i >= 0; --i) {
     const int l = L[i].parent;
     if (l < 0) continue;
-    const vec3<T> hr = R[i] * h[i];
-    const mat3<T> P = spatial::skew(p[i]), Hr = spatial::skew(hr);
-    m[l] += m[i];
-    h[l] += hr + m[i] * p[i];
-    Io[l] += R[i] * Io[i] * R[i].transpose() - m[i] * P * P - P * Hr - Hr * P;
+    const vec3<T> hr = R(i) * h(i);
+    const mat3<T> P = spatial::skew(p(i)), Hr = spatial::skew(hr);
+    m(l) += m(i);
+    h(l) += hr + m(i) * p(i);
+    Io(l) += R(i) * Io(i) * R(i).transpose() - m(i) * P * P - P * Hr - Hr * P;
   }
-  Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> H = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>::Zero(n, n);
+  H.setZero(n, n);
   for (int i = 0; i < n; ++i) {
     // F = Ic_i S_i as (moment n about K_i's origin, force f), in K_i
     vec3<T> f, nm;
     const vec3<T> z(T(0), T(0), T(1));
     if (L[i].revolute) {
-      f = z.cross(h[i]);  // ω = z: f = ω × h, n = I_o ω
-      nm = Io[i] * z;
+      f = z.cross(h(i));  // ω = z: f = ω × h, n = I_o ω
+      nm = Io(i) * z;
     } else {
-      f = m[i] * z;  // v = z: f = m v, n = h × v
-      nm = h[i].cross(z);
+      f = m(i) * z;  // v = z: f = m v, n = h × v
+      nm = h(i).cross(z);
     }
     H(i, i) = L[i].revolute ? nm.z() : f.z();
     for (int j = i; L[j].parent >= 0;) {
-      const vec3<T> fr = R[j] * f;
-      nm = R[j] * nm + p[j].cross(fr);
+      const vec3<T> fr = R(j) * f;
+      nm = R(j) * nm + p(j).cross(fr);
       f = fr;
       j = L[j].parent;
       H(i, j) = H(j, i) = L[j].revolute ? nm.z() : f.z();
     }
     if (L[i].has_armature) H(i, i) += L[i].Ia;
   }
-  return H;
 }
 
 }  // namespace detail
@@ -188,27 +200,8 @@ class tree_rne_fn : public stage_tag {
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
                   const Eigen::MatrixBase<QDD>& qdd) const {
     using T = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>, typename QDD::Scalar>;
-    detail::check_size(q, n_, "q");
-    detail::check_size(qd, n_, "qd");
-    detail::check_size(qdd, n_, "qdd");
-    detail::check_finite(q, "q");
-    if (opt_.velocity) detail::check_finite(qd, "qd");
-    detail::check_finite(qdd, "qdd");
     vecN<T, dynamic> v(n_);
-    const auto run = [&](const std::vector<detail::tree_link<T>>& L) {
-      const vec3<T> g = g_.template cast<T>();
-      if (opt_.gravity)
-        opt_.velocity ? detail::tree_rne_kernel<true, true, T>(L, g, q, qd, qdd, v)
-                      : detail::tree_rne_kernel<true, false, T>(L, g, q, qd, qdd, v);
-      else
-        opt_.velocity ? detail::tree_rne_kernel<false, true, T>(L, g, q, qd, qdd, v)
-                      : detail::tree_rne_kernel<false, false, T>(L, g, q, qd, qdd, v);
-    };
-    if constexpr (std::is_same_v<T, S>)
-      run(links_);
-    else
-      run(detail::cast_links<T>(links_));
-    detail::check_overflow(v, "rne");
+    evaluate(q, qd, qdd, v);
     return v;
   }
 
@@ -224,6 +217,17 @@ class tree_rne_fn : public stage_tag {
   generalized_forces<promote_t<S, X>, dynamic> operator()(const joint_state<X, dynamic>& xi) const {
     return {xi.q.template cast<promote_t<S, X>>(), (*this)(xi.q, xi.qd, xi.qdd)};
   }
+  /// On a temporary ξ (inside a composition) of the model's scalar: v written over q̈ (no
+  /// allocation; the kernel reads q̈_i before it writes v_i), q moved on.
+  template <class X>
+  generalized_forces<promote_t<S, X>, dynamic> operator()(joint_state<X, dynamic>&& xi) const {
+    if constexpr (std::is_same_v<promote_t<S, X>, X>) {
+      evaluate(xi.q, xi.qd, xi.qdd, xi.qdd);
+      return {std::move(xi.q), std::move(xi.qdd)};
+    } else {
+      return (*this)(static_cast<const joint_state<X, dynamic>&>(xi));
+    }
+  }
   /// …and with a memo (what the lift computed for the projection), passed on with (q, v).
   template <class X, class Memo>
   auto operator()(const with_memo<joint_state<X, dynamic>, Memo>& xi) const {
@@ -233,16 +237,49 @@ class tree_rne_fn : public stage_tag {
   }
   template <class X, class Memo>
   auto operator()(with_memo<joint_state<X, dynamic>, Memo>&& xi) const {
-    auto v = (*this)(xi.q, xi.qd, xi.qdd);
     using T = promote_t<S, X>;
-    if constexpr (std::is_same_v<T, X>) {  // q moves on (no copy)
-      return with_memo<generalized_forces<T, dynamic>, Memo>{{std::move(xi.q), std::move(v)}, std::move(xi.memo)};
+    if constexpr (std::is_same_v<T, X>) {  // v over q̈, q moves on (no copy)
+      evaluate(xi.q, xi.qd, xi.qdd, xi.qdd);
+      return with_memo<generalized_forces<T, dynamic>, Memo>{{std::move(xi.q), std::move(xi.qdd)}, std::move(xi.memo)};
     } else {
+      auto v = (*this)(xi.q, xi.qd, xi.qdd);
       return with_memo<generalized_forces<T, dynamic>, Memo>{{xi.q.template cast<T>(), std::move(v)}, std::move(xi.memo)};
     }
   }
 
   const std::vector<detail::tree_link<S>>& links() const { return links_; }
+
+  /// v = rne(q, q̇, q̈) into v (n entries, of the model's and the inputs' scalar; a vector or a
+  /// map: no allocation). v may be q̈'s own storage.
+  template <class Q, class QD, class QDD, class V>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
+                Eigen::MatrixBase<V>& v) const {
+    using T = typename V::Scalar;
+    static_assert(std::is_same_v<T, promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>,
+                                              typename QDD::Scalar>>,
+                  "v's scalar is the model's and the inputs' promoted scalar");
+    detail::check_size(v, n_, "v");
+    detail::check_size(q, n_, "q");
+    detail::check_size(qd, n_, "qd");
+    detail::check_size(qdd, n_, "qdd");
+    detail::check_finite(q, "q");
+    if (opt_.velocity) detail::check_finite(qd, "qd");
+    detail::check_finite(qdd, "qdd");
+    const auto run = [&](const std::vector<detail::tree_link<T>>& L) {
+      const vec3<T> g = g_.template cast<T>();
+      if (opt_.gravity)
+        opt_.velocity ? detail::tree_rne_kernel<true, true, T>(L, g, q, qd, qdd, v)
+                      : detail::tree_rne_kernel<true, false, T>(L, g, q, qd, qdd, v);
+      else
+        opt_.velocity ? detail::tree_rne_kernel<false, true, T>(L, g, q, qd, qdd, v)
+                      : detail::tree_rne_kernel<false, false, T>(L, g, q, qd, qdd, v);
+    };
+    if constexpr (std::is_same_v<T, S>)
+      run(links_);
+    else
+      run(detail::cast_links<T>(links_));
+    detail::check_overflow(v.derived(), "rne");
+  }
 
  private:
   std::vector<detail::tree_link<S>> links_;
@@ -266,13 +303,20 @@ class tree_mass_matrix_fn : public stage_tag {
   template <class Q>
   auto operator()(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<S, typename Q::Scalar>;
+    Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> H;
+    evaluate(q, H);
+    return H;
+  }
+  /// M(q) into H (resized to n × n: no allocation when it is that size already).
+  template <class Q, class T>
+  void evaluate(const Eigen::MatrixBase<Q>& q, Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>& H) const {
+    static_assert(std::is_same_v<T, promote_t<S, typename Q::Scalar>>, "H's scalar is the model's and q's");
     detail::check_size(q, n_, "q");
     detail::check_finite(q, "q");
-    if constexpr (std::is_same_v<T, S>) {
-      return detail::tree_crba_kernel<T>(links_, q);
-    } else {
-      return detail::tree_crba_kernel<T>(detail::cast_links<T>(links_), q);
-    }
+    if constexpr (std::is_same_v<T, S>)
+      detail::tree_crba_kernel<T>(links_, q, H);
+    else
+      detail::tree_crba_kernel<T>(detail::cast_links<T>(links_), q, H);
   }
 
  private:
