@@ -6,6 +6,9 @@
 #   scripts/bench.sh                       # 9 repetitions in random interleaved order, medians
 #   NHDYN_BENCH_REPS=15 scripts/bench.sh   # more repetitions
 #   NHDYN_BENCH_FILTER='^rne/' scripts/bench.sh --no-docs   # a subset, JSON only
+#   NHDYN_BENCH_CLANG=1 scripts/bench.sh   # the two-compiler table's kernels built by clang++-14
+#                                          # (build-bench-clang/, docs/performance-clang.json);
+#                                          # the tables are then regenerated from both JSON files
 #
 # Environment: NHDYN_BENCH_BUILD (build dir, default build-bench), NHDYN_BENCH_REPS (9),
 # NHDYN_BENCH_MIN_TIME (seconds per repetition, 0.1), NHDYN_BENCH_FILTER (regex, all),
@@ -16,10 +19,21 @@
 # sides of a ratio then sample the same drift instead of different minutes.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-build="${NHDYN_BENCH_BUILD:-$root/build-bench}"
+# Debian's python3 carries matplotlib (python3-matplotlib); prefer it over other pythons on PATH.
+py=/usr/bin/python3
+[ -x "$py" ] || py=python3
+clang="${NHDYN_BENCH_CLANG:-0}"
+if [ "$clang" = 1 ]; then
+  export CXX="${CXX:-clang++-14}"
+  build="${NHDYN_BENCH_BUILD:-$root/build-bench-clang}"
+  filter="${NHDYN_BENCH_FILTER:-$("$py" "$root/scripts/perf_table.py" --print-clang-filter)}"
+  NHDYN_BENCH_SCALAR=0
+else
+  build="${NHDYN_BENCH_BUILD:-$root/build-bench}"
+  filter="${NHDYN_BENCH_FILTER:-.}"
+fi
 reps="${NHDYN_BENCH_REPS:-9}"
 min_time="${NHDYN_BENCH_MIN_TIME:-0.1}"
-filter="${NHDYN_BENCH_FILTER:-.}"
 docs=1
 [ "${1:-}" = "--no-docs" ] && docs=0
 
@@ -32,6 +46,7 @@ targets=(nhdyn_bench); [ "$scalar" = 1 ] && targets+=(nhdyn_bench_scalar)
 make -C "$build" -j2 "${targets[@]}"
 
 json="$root/docs/performance.json"
+[ "$clang" = 1 ] && json="$root/docs/performance-clang.json"
 [ $docs -eq 0 ] && json="$build/performance.json"
 "$build/bench/nhdyn_bench" --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true \
   --benchmark_min_time="$min_time" --benchmark_filter="$filter" \
@@ -39,13 +54,18 @@ json="$root/docs/performance.json"
 echo "bench.sh: wrote $json"
 [ $docs -eq 0 ] && exit 0
 
-# Debian's python3 carries matplotlib (python3-matplotlib); prefer it over other pythons on PATH.
-py=/usr/bin/python3
-[ -x "$py" ] || py=python3
 cpu="$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -1)"
-compiler="$("$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")" --version | head -1)"
-"$py" "$root/scripts/perf_table.py" "$json" "$root/docs/performance.md" "$root/docs/performance_scaling.png" \
-  --cpu "$cpu" --compiler "$compiler"
+compiler_of() { "$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$1/CMakeCache.txt")" --version | head -1; }
+# The tables: from the g++ build's JSON, with the clang build's beside it when there is one.
+main_build="$root/build-bench" clang_build="$root/build-bench-clang"
+[ "$clang" = 1 ] && clang_build="$build" || main_build="$build"
+main_json="$root/docs/performance.json" clang_json="$root/docs/performance-clang.json"
+second=()
+[ -f "$clang_json" ] && [ -f "$clang_build/CMakeCache.txt" ] && second=(--second "$clang_json" --second-compiler "$(compiler_of "$clang_build")")
+"$py" "$root/scripts/perf_table.py" "$main_json" "$root/docs/performance.md" "$root/docs/performance_scaling.png" \
+  --cpu "$cpu" --compiler "$(compiler_of "$main_build")" "${second[@]}"
+[ "$clang" = 1 ] && exit 0
+compiler="$(compiler_of "$main_build")"
 
 # The Python module's call overhead and batch throughput (issue 16), when it can be built.
 if grep -q '^NHDYN_BUILD_PYTHON:BOOL=ON' "$build/CMakeCache.txt"; then

@@ -441,6 +441,40 @@ def plot(med, path):
     fig.savefig(path, dpi=110)
 
 
+# The kernels timed under both compilers (issue 33): (label, model, benchmark name)
+TWO_COMPILERS = (
+    [("rne", m, f"rne/{m}/nhdyn") for m in ["puma560", "rev24"] + TREE_MODELS]
+    + [("CRBA", m, f"crba/{m}/nhdyn") for m in TREE_MODELS]
+    + [("ABA", "rev24", "fd/rev24/aba")] + [("ABA", m, f"batch_fd/{m}/one") for m in TREE_MODELS]
+    + [("∂τ/∂(q, q̇)", m, f"deriv_rne/{m}/analytic") for m in TREE_MODELS]
+    + [("nonholonomic id", m, f"nh_id/{m}/rne") for m in ["paper5", "mecanum_arm", "castor_drive_arm"]])
+TARGET_CLANG = 1.1
+# the benchmark filter of that run (scripts/bench.sh, NHDYN_BENCH_CLANG=1)
+CLANG_FILTER = "^(" + "|".join(re.escape(n) for _, _, n in TWO_COMPILERS) + ")$"
+
+
+def two_compilers(med, second_med, second_compiler, first_compiler):
+    out = ["### Two compilers: the same kernels built by clang (issue 33)\n"]
+    out.append(f"The benchmarks below from a second build of `nhdyn_bench` by {second_compiler} (same flags, "
+               f"`NHDYN_BENCH_CLANG=1 scripts/bench.sh`: `build-bench-clang/`, docs/performance-clang.json), beside "
+               f"this page's build by {first_compiler}; medians, ns per call, each build's own run.\n")
+    out.append("| kernel | model | g++ | clang | clang / g++ |")
+    out.append("|---|---|---:|---:|---:|")
+    worst = 0.0
+    for label, m, name in TWO_COMPILERS:
+        a, b = med.get(name), second_med.get(name)
+        if a is None and b is None:
+            continue
+        r = ratio(b, a)
+        worst = max(worst, r or 0)
+        out.append(f"| {label} | {m} | {ns(a)} | {ns(b)} | {r2(r)} |")
+    out.append("")
+    out.append(f"- Target every kernel under clang within {TARGET_CLANG}× its g++ time: worst **{worst:.2f}** — "
+               f"{'met' if 0 < worst <= TARGET_CLANG else 'NOT met'}.")
+    out.append("")
+    return "\n".join(out) + "\n"
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("json")
@@ -448,9 +482,20 @@ def main():
     ap.add_argument("png")
     ap.add_argument("--cpu", default="unknown CPU")
     ap.add_argument("--compiler", default="unknown compiler")
+    ap.add_argument("--second", help="a second build's JSON (clang): the two-compiler table")
+    ap.add_argument("--second-compiler", default="clang")
+    ap.add_argument("--print-clang-filter", action="store_true", help="print the second run's benchmark filter")
+    if "--print-clang-filter" in sys.argv:
+        print(CLANG_FILTER)
+        return
     a = ap.parse_args()
     ctx, med, allocs, reps = load(a.json)
     text = tables(ctx, med, allocs, reps, a.cpu, a.compiler)
+    if a.second:
+        saved = dict(PAIRED)
+        _, second_med, _, _ = load(a.second)
+        PAIRED.clear(), PAIRED.update(saved)  # the tables' paired ratios stay the first build's
+        text += two_compilers(med, second_med, a.second_compiler, a.compiler)
     with open(a.doc) as f:
         doc = f.read()
     if BEGIN not in doc or END not in doc:

@@ -646,9 +646,9 @@ class wheeled_base {
         x.o = P.o + P.turn(nd.D);
         x.a = P.turn(nd.axis);
       } else if (nd.revolute) {
-        using std::cos;
-        using std::sin;
-        const T qi = T(nd.sign) * T(q(nd.joint)), cq = cos(qi), sq = sin(qi);
+        const T qi = T(nd.sign) * T(q(nd.joint));
+        const auto sc = detail::sincos_of(qi);  // the tree kernels' sin/cos (model/dh_kernel.hpp)
+        const T &cq = sc.c, &sq = sc.s;
         x.c = P.c * cq - P.s * sq, x.s = P.s * cq + P.c * sq;
         x.o = P.o + P.turn(nd.D);
       } else {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "dh_kernel.hpp"
 #include "tree.hpp"
 
 namespace nhdyn::detail {
@@ -103,9 +104,11 @@ std::vector<tree_link<T>> cast_links(const std::vector<tree_link<S>>& links) {
 template <class T, class LS>
 void kernel_placement(const tree_link<LS>& k, const T& qi, mat3<T>& R, vec3<T>& p) {
   if (k.revolute) {
-    using std::cos;
-    using std::sin;
-    const T c = cos(qi), s = sin(qi);
+    // sincos_kernel for a double (no library call; the chain kernels' numbers), a dual's one
+    // sin/cos of its value, an interval's pair, a SIMD pack's own (dh_kernel.hpp)
+    const auto sc = sincos_of(qi);
+    const T& c = sc.c;
+    const T& s = sc.s;
     R.col(0) = c * k.R.col(0) + s * k.R.col(1);
     R.col(1) = c * k.R.col(1) - s * k.R.col(0);
     R.col(2) = k.R.col(2).template cast<T>();
