@@ -343,7 +343,7 @@ class rne_derivatives_fn {
   }
 
   /// Into a result whose matrices are reused: no allocation after the first call of a size, for
-  /// trees of up to 32 bodies (the scratch then lives on the stack). `out` must not alias the
+  /// trees of up to 55 bodies (the scratch then lives on the stack: 32 KiB). `out` must not alias the
   /// inputs.
   template <class Q, class QD, class QDD>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,

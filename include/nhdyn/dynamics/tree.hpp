@@ -39,7 +39,7 @@ void tree_rne_kernel_impl(const std::vector<tree_link<LS>>& L, const vec3<T>& g,
     vec3<T> w, dw, a, f, m;
   };
   // on the stack up to 32 KiB of it (170 bodies in double), beyond on the heap; not zeroed
-  small_buffer<ws, dynamic, std::max<std::size_t>(8, 32768 / sizeof(ws))> s(n);
+  small_buffer<ws, dynamic> s(n);
   const vec3<T> zero = vec3<T>::Zero();
   const vec3<T> a0 = Gravity ? vec3<T>(-g) : zero;
   for (int i = 0; i < n; ++i) {
@@ -127,7 +127,7 @@ void tree_crba_kernel(const std::vector<tree_link<T>>& L, const Q& q, Out& H) {
     vec3<T> p, h;
     T m;
   };
-  small_buffer<ws, dynamic, std::max<std::size_t>(8, 32768 / sizeof(ws))> s(n);
+  small_buffer<ws, dynamic> s(n);
   const auto R = [&](int i) -> mat3<T>& { return s[i].R; };
   const auto Io = [&](int i) -> mat3<T>& { return s[i].Io; };
   const auto p = [&](int i) -> vec3<T>& { return s[i].p; };
