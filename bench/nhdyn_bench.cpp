@@ -849,9 +849,10 @@ int main(int argc, char** argv) {
                                    std::pair{"castor_drive_arm", "castor_drive_arm.json"},
                                    std::pair{"powered_castors_arm", "powered_castors_arm.json"}}) {
     const auto r = nhdyn::io::load_robot_file(std::string(NHDYN_SOURCE_DIR "/examples/robots/") + file);
+    const std::string robot = name;  // a lambda may not capture a structured binding under clang 14
     std::visit([&](const auto& c) {
-      register_wheeled(name, r.model, c);
-      register_deriv_nh(name, r.model, c);
+      register_wheeled(robot, r.model, c);
+      register_deriv_nh(robot, r.model, c);
     }, *r.constraint);
     if (std::string(name) == "mobile_manipulator_wheels") {  // the same two wheels as a wheeled_base: `wheels` is its fast instance
       const nhdyn::wheeled_base<double> wb(r.model, {{nhdyn::wheel_kind::fixed, "wheel_left_joint", "", 0.1},
