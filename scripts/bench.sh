@@ -60,12 +60,12 @@ compiler_of() { "$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$1/CMakeCache.txt"
 main_build="$root/build-bench" clang_build="$root/build-bench-clang"
 [ "$clang" = 1 ] && clang_build="$build" || main_build="$build"
 main_json="$root/docs/performance.json" clang_json="$root/docs/performance-clang.json"
+compiler="$(compiler_of "$main_build")"
 second=()
 [ -f "$clang_json" ] && [ -f "$clang_build/CMakeCache.txt" ] && second=(--second "$clang_json" --second-compiler "$(compiler_of "$clang_build")")
 "$py" "$root/scripts/perf_table.py" "$main_json" "$root/docs/performance.md" "$root/docs/performance_scaling.png" \
-  --cpu "$cpu" --compiler "$(compiler_of "$main_build")" "${second[@]}"
+  --cpu "$cpu" --compiler "$compiler" "${second[@]}"
 [ "$clang" = 1 ] && exit 0
-compiler="$(compiler_of "$main_build")"
 
 # The Python module's call overhead and batch throughput (issue 16), when it can be built.
 if grep -q '^NHDYN_BUILD_PYTHON:BOOL=ON' "$build/CMakeCache.txt"; then

@@ -491,10 +491,8 @@ def main():
     a = ap.parse_args()
     ctx, med, allocs, reps = load(a.json)
     text = tables(ctx, med, allocs, reps, a.cpu, a.compiler)
-    if a.second:
-        saved = dict(PAIRED)
+    if a.second:  # (after tables(): the second file's paired ratios, if any, do not reach them)
         _, second_med, _, _ = load(a.second)
-        PAIRED.clear(), PAIRED.update(saved)  # the tables' paired ratios stay the first build's
         text += two_compilers(med, second_med, a.second_compiler, a.compiler)
     with open(a.doc) as f:
         doc = f.read()

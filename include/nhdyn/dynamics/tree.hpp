@@ -13,7 +13,6 @@
 /// computed once when the function object is built. Velocities and forces are 3-vectors in
 /// those frames (the Luh–Walker–Paul form of the same recursion).
 #include <Eigen/Core>
-#include <algorithm>
 #include <vector>
 
 #include "../detail/attributes.hpp"
