@@ -10,6 +10,8 @@
 ///   nh_inertia/<model>/{crba, rne_columns}      M_η = SᵀMS two ways
 ///   rne/<tree>/{nhdyn, reference, kdl}          rne on kinematic trees (the kernel, the plain
 ///   crba/<tree>/{nhdyn, reference}               spatial-algebra reference, KDL's tree solver);
+///   {rne, crba, aba}/<tree>/evaluate            the kernels into a result the caller reuses;
+///   aba/<tree>/nhdyn                            ABA on the tree (a returned q̈)
 ///   fd/<model>/{aba, aba_reference, crba_ldlt, kdl}  holonomic forward dynamics: the articulated-
 ///                                               body algorithm (kernel, reference), CRBA + LDLᵀ, KDL
 ///                                               mass matrix by the kernel and the reference
@@ -431,6 +433,22 @@ void register_tree(const std::string& model, const nhdyn::tree<double>& t) {
       opaque(s.q);
       M.evaluate(s.q, Hm);
       benchmark::DoNotOptimize(Hm.data());
+    });
+    // ABA (q̈ for τ = rne(q, q̇, q̈) gives q̈ back), as a call and into a reused q̈
+    const auto fd = nhdyn::aba(t);
+    agree(fd(s.q, s.qd, tau), s.qdd, 1e-8, "aba/" + model + ": aba inverts rne");
+    Eigen::VectorXd a(n);
+    fd.evaluate(s.q, s.qd, tau, a);
+    agree(a, fd(s.q, s.qd, tau), 0, "aba/" + model + ": evaluate vs the call");
+    add("aba/" + model + "/nhdyn", [fd, s, tau]() mutable {
+      opaque(s.q), opaque(s.qd), opaque(tau);
+      auto r = fd(s.q, s.qd, tau);
+      benchmark::DoNotOptimize(r);
+    });
+    add("aba/" + model + "/evaluate", [fd, s, tau, a]() mutable {
+      opaque(s.q), opaque(s.qd), opaque(tau);
+      fd.evaluate(s.q, s.qd, tau, a);
+      benchmark::DoNotOptimize(a.data());
     });
   }
   add("crba/" + model + "/reference", [t, s]() mutable {

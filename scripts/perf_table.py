@@ -246,11 +246,12 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
     out.append("### Kinematic trees: rne and CRBA against KDL's tree solver and the plain reference (issue 13)\n")
     out.append("`rne/<tree>/{nhdyn, reference, kdl}`, `crba/<tree>/{nhdyn, reference}`: the shipped mobile "
                "manipulator's URDF and random branching trees (run-time sized); `{rne, crba}/<tree>/evaluate`: "
-               "the same kernels into a vector or matrix the caller reuses (`evaluate`). CRBA / rne: the two "
+               "the same kernels into a vector or matrix the caller reuses (`evaluate`); `aba/<tree>/{nhdyn, "
+               "evaluate}`: the articulated-body forward dynamics, the same two ways. CRBA / rne: the two "
                "calls' medians (not paired).\n")
     out.append("| tree | bodies | rne nhdyn | rne reference | rne KDL | nhdyn / KDL | CRBA nhdyn | CRBA reference | CRBA / rne | "
-               "allocations (rne, CRBA) | allocations, evaluate (rne, CRBA) |")
-    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---|")
+               "ABA nhdyn | allocations (rne, CRBA, ABA) | allocations, evaluate (rne, CRBA, ABA) |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|")
     worst_tree = 0.0
     for m in TREE_MODELS:
         a, r, k = g(f"rne/{m}/nhdyn"), g(f"rne/{m}/reference"), g(f"rne/{m}/kdl")
@@ -259,8 +260,10 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
         worst_tree = max(worst_tree, ratio(a, k) or 0)
         out.append(f"| {m} | {TREE_BODIES[m]} | {ns(a)} | {ns(r)} | {ns(k)} | {r2(ratio(a, k))} | "
                    f"{ns(g(f'crba/{m}/nhdyn'))} | {ns(g(f'crba/{m}/reference'))} | {r2(ratio(g(f'crba/{m}/nhdyn'), a))} | "
-                   f"{al(allocs.get(f'rne/{m}/nhdyn'))}, {al(allocs.get(f'crba/{m}/nhdyn'))} | "
-                   f"{al(allocs.get(f'rne/{m}/evaluate'))}, {al(allocs.get(f'crba/{m}/evaluate'))} |")
+                   f"{ns(g(f'aba/{m}/nhdyn'))} | "
+                   f"{al(allocs.get(f'rne/{m}/nhdyn'))}, {al(allocs.get(f'crba/{m}/nhdyn'))}, {al(allocs.get(f'aba/{m}/nhdyn'))} | "
+                   f"{al(allocs.get(f'rne/{m}/evaluate'))}, {al(allocs.get(f'crba/{m}/evaluate'))}, "
+                   f"{al(allocs.get(f'aba/{m}/evaluate'))} |")
     out.append("")
     out.append(f"- Target rne ≤ {TARGET_TREE}× KDL's tree solver on every tree: worst **{worst_tree:.2f}** — "
                f"{'met' if 0 < worst_tree <= TARGET_TREE else 'NOT met'}.")

@@ -60,6 +60,34 @@ TEST_CASE("aba = CRBA + LDLT forward dynamics and inverts rne, on random trees o
   }
 }
 
+TEST_CASE("aba into reused storage (evaluate) gives the call's numbers, also over τ's own storage and beyond the stack scratch", "[aba]") {
+  std::mt19937_64 rng(31);
+  for (int n : {3, 16, 80}) {  // 80 bodies: the kernel's scratch beyond its stack part (51 in double)
+    const auto t = nhdyn_ref::random_tree(rng, n, 0.4, true);
+    const auto fd = aba(t);
+    VectorXd a(n);
+    for (int s = 0; s < 2; ++s) {  // the same storage twice
+      const VectorXd q = random_vec(rng, n, 2), qd = random_vec(rng, n, 2), tau = random_vec(rng, n, 5);
+      INFO("n = " << n);
+      const VectorXd want = fd(q, qd, tau);
+      // an independent check that the call itself is right (the 6×6 book algorithm)
+      CHECK(rel(reference::aba<double>(t, q, qd, tau), want) <= 1e-10);
+      fd.evaluate(q, qd, tau, a);
+      CHECK(a == want);  // bit for bit
+      VectorXd w = tau;  // q̈ over τ's own storage
+      fd.evaluate(q, qd, w, w);
+      CHECK(w == want);
+      double buf[80];  // into a map of the caller's storage
+      Eigen::Map<VectorXd> mv(buf, n);
+      fd.evaluate(q, qd, tau, mv);
+      CHECK(mv == want);
+    }
+    VectorXd wrong(n + 1);
+    CHECK_THROWS_WITH(fd.evaluate(VectorXd::Zero(n), VectorXd::Zero(n), VectorXd::Zero(n), wrong),
+                      Catch::Contains("qdd") && Catch::Contains(std::to_string(n)));
+  }
+}
+
 TEST_CASE("aba far from the world origin: translating the whole tree leaves q̈ unchanged", "[aba]") {
   // A physics invariant (uniform gravity): the robot 1e5…1e6 m from the origin moves as at it.
   // The kernel keeps each body's origin (not the world's), so nothing grows with the distance.

@@ -243,7 +243,23 @@ class aba_fn : public stage_tag {
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
                   const Eigen::MatrixBase<TAU>& tau) const {
     using T = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>, typename TAU::Scalar>;
+    vecN<T, dynamic> out(dof());
+    evaluate(q, qd, tau, out);
+    return out;
+  }
+
+  /// q̈ = aba(q, q̇, τ) into qdd (n entries, of the model's and the inputs' promoted scalar; a
+  /// vector or a map the caller reuses: no allocation). qdd may be τ's (or q's, q̇'s) own
+  /// storage: the kernel has read them all before its last pass writes q̈.
+  template <class Q, class QD, class TAU, class QDD>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
+                Eigen::MatrixBase<QDD>& qdd) const {
+    using T = typename QDD::Scalar;
+    static_assert(std::is_same_v<T, promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>,
+                                              typename TAU::Scalar>>,
+                  "qdd's scalar is the model's and the inputs' promoted scalar");
     const int n = dof();
+    detail::check_size(qdd, n, "qdd");
     detail::check_size(q, n, "q");
     detail::check_size(qd, n, "qd");
     detail::check_size(tau, n, "tau");
@@ -259,15 +275,13 @@ class aba_fn : public stage_tag {
       if (std::isfinite(d) && d > 0 && d * d > tol * tol * u2 * s2) return;
       refuse(i, d, std::sqrt(u2 * s2));
     };
-    vecN<T, dynamic> out(n);
     if constexpr (std::is_same_v<T, S>) {
-      detail::tree_aba_kernel<T>(links_, g_, q, qd, tau, out, check);
+      detail::tree_aba_kernel<T>(links_, g_, q, qd, tau, qdd, check);
     } else {
-      detail::tree_aba_kernel<T>(detail::cast_links<T>(links_), vec3<T>(g_.template cast<T>()), q, qd, tau, out,
+      detail::tree_aba_kernel<T>(detail::cast_links<T>(links_), vec3<T>(g_.template cast<T>()), q, qd, tau, qdd,
                                  check);
     }
-    detail::check_overflow(out, "aba");
-    return out;
+    detail::check_overflow(qdd.derived(), "aba");
   }
 
   /// With applied forces (external wrenches, dynamics/wrench.hpp): q̈ for τ + Q_ext(q).
