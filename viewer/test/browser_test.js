@@ -194,8 +194,14 @@ async function uiChecks(page, a, viewClip) {
   await page.evaluate((k) => { window.nhdyn.setRun(k); window.nhdyn.setTime(window.NHDYN_DATA.runs[k].t[0]); }, a.run);
   const before = await st();
   await page.click('#play');
-  await new Promise((r) => setTimeout(r, 600));
-  const during = await st();
+  // Time moves in animation frames: on a loaded machine (a parallel ctest, software WebGL) the
+  // first frame can take longer than a fixed wait, so poll until it moves (at most 10 s).
+  const deadline = Date.now() + 10000;
+  let during;
+  do {
+    await new Promise((r) => setTimeout(r, 200));
+    during = await st();
+  } while (during.playing && !(during.t > before.t) && Date.now() < deadline);
   await page.click('#play');
   const after = await st();
   check(during.playing && during.t > before.t && !after.playing, 'play advances the time, pause stops it',
