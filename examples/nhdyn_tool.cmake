@@ -11,7 +11,7 @@ file(GLOB NHDYN_TOOL_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/nhdyn
 list(FILTER NHDYN_TOOL_SOURCES EXCLUDE REGEX "/main\\.cpp$")
 add_library(nhdyn_tool_objects OBJECT ${NHDYN_TOOL_SOURCES})
 target_link_libraries(nhdyn_tool_objects PUBLIC nhdyn::json nhdyn::boost CLI11::CLI11
-                                         PRIVATE nhdyn_project_options)
+                                         PRIVATE nhdyn_project_options nhdyn_program_options)
 target_include_directories(nhdyn_tool_objects PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/nhdyn_tool)
 if(TARGET nhdyn::urdf)  # --model x.urdf
   target_link_libraries(nhdyn_tool_objects PUBLIC nhdyn::urdf)
@@ -30,7 +30,7 @@ else()
 endif()
 add_executable(nhdyn_tool ${CMAKE_CURRENT_SOURCE_DIR}/nhdyn_tool/main.cpp)
 set_target_properties(nhdyn_tool PROPERTIES OUTPUT_NAME nhdyn RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/${CMAKE_INSTALL_BINDIR})
-target_link_libraries(nhdyn_tool PRIVATE nhdyn_tool_objects nhdyn_project_options)
+target_link_libraries(nhdyn_tool PRIVATE nhdyn_tool_objects nhdyn_project_options nhdyn_program_options)
 add_dependencies(nhdyn_tool nhdyn_data)
 if(TARGET nhdyn_viewer)  # nhdyn view's page template
   add_dependencies(nhdyn_tool nhdyn_viewer)

@@ -5,6 +5,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DNHDYN_BUILD_TESTS=OFF >/dev/null
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DNHDYN_BUILD_TESTS=OFF -DNHDYN_PROGRAM_OPT= >/dev/null  # -O3 even after scripts/test.sh
 cmake --build build -j"$(nproc)" --target nhdyn_tool
 ./build/bin/nhdyn simulate paper --out out/paper

@@ -16,4 +16,5 @@ add_test(NAME install_consumer
     "-DGENERATOR=${CMAKE_GENERATOR}"
     "-DWITH_TOOL=$<TARGET_EXISTS:nhdyn_tool>"
     -P "${CMAKE_CURRENT_SOURCE_DIR}/install_consumer/run_install_test.cmake")
-set_tests_properties(install_consumer PROPERTIES TIMEOUT 1800)
+# COST: the longest test (it builds a project): ctest -j starts it first, the rest beside it.
+set_tests_properties(install_consumer PROPERTIES TIMEOUT 1800 COST 1000)
