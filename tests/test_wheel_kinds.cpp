@@ -433,7 +433,7 @@ TEST_CASE("wheeled_base: 'wheels' = wheeled_base with the same two fixed wheels 
   }
 }
 
-TEST_CASE("wheeled_base: an unforced 10 s motion of each shipped base keeps A q_dot = 0 and the energy, whose error falls as RK4's h^4", "[wheel_kinds]") {
+TEST_CASE("wheeled_base: an unforced 10 s motion of each shipped base keeps A q_dot = 0 and the energy, whose error falls as RK4's h^4", "[wheel_kinds][long]") {
   for (const auto& file : shipped) {
     INFO(file);
     const auto r = load(file);

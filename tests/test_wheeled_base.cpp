@@ -247,7 +247,7 @@ TEST_CASE("wheeled robots: rolling checked by kinematics (contact points do not 
   }
 }
 
-TEST_CASE("wheeled robots: an unforced 10 s motion keeps A q_dot = 0 and the energy", "[wheeled]") {
+TEST_CASE("wheeled robots: an unforced 10 s motion keeps A q_dot = 0 and the energy", "[wheeled][long]") {
   // τ = 0: the arm falls under gravity and the base moves in reaction, on its wheels.
   for (const std::string file : {"mobile_manipulator_wheels.json", "mobile_manipulator_bicycle.json"}) {
     const auto r = load(file);
