@@ -12,6 +12,8 @@
 ///   of each shipped base keeps |A q̇| at rounding level and its energy (error falling as RK4's h⁴);
 /// - a mecanum base turns its wheels at the textbook mecanum rates (Lynch and Park, eq. 13.10);
 /// - `wheels` = `wheeled_base` with the same two fixed wheels (τ, λ, η̇ to 1e-12);
+/// - inverse_dynamics' `evaluate` into a reused τ = the composition's τ bit for bit, for every
+///   robot file's constraint (the two paths share the stages, not the storage);
 /// - rank, mobility and the errors: coaxial rows kept once, skid-steer and immobile bases
 ///   reported, a singular configuration and missing actuators named.
 #include <catch2/catch.hpp>
@@ -332,6 +334,56 @@ TEST_CASE("wheeled_base: tau and lambda = the projected Euler-Lagrange equations
       const double power = f.tau.dot(E.transpose() * qd);
       CHECK(std::abs(double(dE) - power) <= 1e-10 * (1 + std::abs(double(dE)) + f.tau.norm() * qd.norm()));
     }
+  }
+}
+
+TEST_CASE("inverse_dynamics on a tree: evaluate into a reused tau = the composition's tau bit for bit, for every "
+          "robot file's constraint, in double and in duals; its errors name tau, eta and eta_dot",
+          "[wheel_kinds]") {
+  std::mt19937 rng(2026);
+  for (const char* file : {"mobile_manipulator.json", "mobile_manipulator_wheels.json", "mobile_manipulator_bicycle.json",
+                           "mobile_manipulator_castors.json", "mecanum_arm.json", "omni3_arm.json",
+                           "castor_drive_arm.json", "powered_castors_arm.json", "tiago_style.json"}) {
+    INFO(file);
+    const auto r = load(file);
+    std::visit(
+        [&](const auto& c) {
+          const auto id = inverse_dynamics(r.model, c);
+          const int p = actuator_count(c);
+          VectorXd tau = VectorXd::Constant(p, 7.0);  // reused across the states: every entry rewritten
+          for (int trial = 0; trial < 3; ++trial) {
+            const VectorXd q = random_q(c.dof(), rng), eta = random_vec(c.m(), rng), eta_dot = random_vec(c.m(), rng, 2);
+            id.evaluate(q, eta, eta_dot, tau);
+            const VectorXd call = id(q, eta, eta_dot);  // lift → ξ, rne on ξ, project: three heap vectors
+            REQUIRE(call.size() == p);
+            CHECK((tau.array() == call.array()).all());
+            // into a block of a larger matrix (a map: the caller's own storage)
+            MatrixXd out = MatrixXd::Zero(p, 2);
+            Eigen::Map<VectorXd> col(out.col(1).data(), p);
+            id.evaluate(q, eta, eta_dot, col);
+            CHECK((out.col(1).array() == call.array()).all());
+            CHECK(out.col(0).isZero(0));
+          }
+          // duals along η: the same numbers and derivatives as the composition's
+          using D = dual<double, 1>;
+          const VectorXd q = random_q(c.dof(), rng), eta = random_vec(c.m(), rng), eta_dot = random_vec(c.m(), rng);
+          vecN<D, dynamic> ed(c.m());
+          for (int j = 0; j < c.m(); ++j) ed(j) = D(eta(j), {j == 0 ? 1.0 : 0.0});
+          vecN<D, dynamic> td(p);
+          id.evaluate(q, ed, ed, td);
+          const vecN<D, dynamic> cd = id(q, ed, ed);
+          for (int j = 0; j < p; ++j) {
+            CHECK(td(j).value() == cd(j).value());
+            CHECK(td(j).derivative(0) == cd(j).derivative(0));
+          }
+          // errors: the caller's names
+          VectorXd short_tau(p + 1), bad = eta;
+          CHECK_THROWS_WITH(id.evaluate(q, eta, eta_dot, short_tau), Catch::Matchers::Contains("tau"));
+          CHECK_THROWS_WITH(id.evaluate(q, VectorXd(eta.head(c.m() - 1)), eta_dot, tau), Catch::Matchers::Contains("eta"));
+          bad(0) = std::numeric_limits<double>::quiet_NaN();
+          CHECK_THROWS_WITH(id.evaluate(q, eta, bad, tau), Catch::Matchers::Contains("eta_dot"));
+        },
+        *r.constraint);
   }
 }
 

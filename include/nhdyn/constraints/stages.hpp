@@ -17,6 +17,7 @@
 /// `inverse_dynamics(model, c, o, friction(model))` puts rne + friction in rne's place
 /// (the joints' friction, dynamics/terms.hpp).
 #include "../detail/ldlt.hpp"
+#include "../detail/small_buffer.hpp"
 #include "../dynamics/friction.hpp"
 #include "../dynamics/rne.hpp"
 #include "../dynamics/tree.hpp"
@@ -99,6 +100,20 @@ class lift_fn : public stage_tag {
   template <class X, int N, int M>
   auto operator()(const reduced_state<X, N, M>& z) const {
     return (*this)(z.q, z.eta, z.eta_dot);
+  }
+  /// ξ's q̇ and q̈ into qd and qdd (n entries each, one scalar; vectors or maps), where the
+  /// constraint lifts into given storage (lift_into); returns its memo. The same checks and
+  /// numbers as the call above, without allocating ξ.
+  template <class Q, class E, class ED, class QDo, class QDDo>
+    requires requires(const C& c, const Q& q, const E& e, const ED& ed, QDo& qd, QDDo& qdd) {
+      c.lift_into(q, e, ed, qd, qdd);
+    }
+  auto into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
+            Eigen::MatrixBase<QDo>& qd, Eigen::MatrixBase<QDDo>& qdd) const {
+    detail::check_reduced_state(c_, q, eta, eta_dot);
+    detail::check_size(qd, c_.dof(), "qd");
+    detail::check_size(qdd, c_.dof(), "qdd");
+    return c_.lift_into(q, eta, eta_dot, qd, qdd);
   }
 
  private:
@@ -195,6 +210,22 @@ class project_fn : public stage_tag {
     } else {
       return (*this)(static_cast<generalized_forces<X, N>&&>(f));
     }
+  }
+  /// τ into tau (actuator_count entries, of the promoted scalar) from (q, v) and the lift's
+  /// memo: the call above's numbers, bit for bit. Without allocation where the constraint
+  /// projects into given storage (wheeled_base's project_into; an orthonormal S's
+  /// St_times_into); else τ is formed as the call on (q, v) forms it and copied.
+  template <class Q, class V, class Memo, class Tau>
+  void into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v, const Memo& memo,
+            Eigen::MatrixBase<Tau>& tau) const {
+    detail::check_size(v, c_.dof(), "v");
+    detail::check_size(tau, actuator_count(c_), "tau");
+    if constexpr (requires { c_.project_into(q, v, memo, tau); })
+      c_.project_into(q, v, memo, tau);
+    else if constexpr (C::orthonormal_S && !has_input_map<C, Q> && requires { c_.St_times_into(v, memo, tau); })
+      c_.St_times_into(v, memo, tau);  // SᵀS = I: Sᵀv is τ
+    else
+      tau = detail::solve_StE(c_, q, apply_St(c_, q, v));
   }
 
  private:
@@ -311,11 +342,54 @@ auto nh_tree_pipeline(const tree<S>& t, const C& c, rne_options o, Out out) {
 }
 }  // namespace detail
 
+namespace detail {
+/// inverse_dynamics on a tree (constraint run-time sized): the composition project ∘ rne ∘
+/// lift itself (it derives from it: every call form it has, the same numbers), and
+/// `evaluate(q, η, η̇, τ)`, the same three stages into storage: lift.into writes ξ's q̇ and q̈
+/// into stack scratch (heap beyond 256 joints), rne.evaluate writes v over q̈, project.into
+/// writes τ into the caller's vector. No allocation where the constraint lifts and projects
+/// into given storage (wheeled_base with k·|η ∩ W| ≤ 24, differential_drive); the others
+/// allocate their projection's solve (bicycle, rolling_wheels: (SᵀS)⁻¹).
+template <class Composed, class C>
+struct tree_inverse_dynamics : Composed {
+  explicit tree_inverse_dynamics(Composed c) : Composed(std::move(c)) {}
+
+  /// τ into tau (actuator_count(c) entries, of the promoted scalar of the constraint, q, η
+  /// and η̇; a vector or a map): bit for bit the call's τ.
+  template <class Q, class E, class ED, class Tau>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
+                Eigen::MatrixBase<Tau>& tau) const {
+    const auto& projection = this->f;
+    const auto& dynamics = this->g.f;
+    const auto& lifting = this->g.g;
+    using T = typename Tau::Scalar;
+    static_assert(std::is_same_v<T, promote_t<promote_t<promote_t<typename constraint_scalar<C>::type, typename Q::Scalar>,
+                                                                 typename E::Scalar>,
+                                                      typename ED::Scalar>>,
+                  "tau's scalar is the promoted scalar of the constraint, q, eta and eta_dot");
+    const int n = dynamics.dof();
+    small_buffer<T, dynamic, 256> qd_store(n), v_store(n);
+    Eigen::Map<vecN<T, dynamic>> qd(qd_store.data(), n), v(v_store.data(), n);
+    const auto memo = lifting.into(q, eta, eta_dot, qd, v);  // q̈ into v's storage
+    dynamics.evaluate(q, qd, v, v);                          // v over q̈
+    projection.into(q, v, memo, tau);
+  }
+};
+}  // namespace detail
+
 /// The nonholonomic inverse dynamics of a tree: project ∘ rne ∘ lift, the constraint over the
-/// tree's joints in q order.
+/// tree's joints in q order. With a run-time-sized constraint that lifts into given storage,
+/// it also evaluates into a τ the caller reuses (`evaluate(q, eta, eta_dot, tau)`).
 template <class S, pfaffian_constraint C>
 auto inverse_dynamics(const tree<S>& t, const C& c, rne_options o = {}) {
-  return detail::nh_tree_pipeline(t, c, o, project(c));
+  auto id = detail::nh_tree_pipeline(t, c, o, project(c));
+  constexpr bool lifts_into = requires(const C& k, const vecN<S, dynamic>& x, Eigen::Map<vecN<S, dynamic>>& m) {
+    k.lift_into(x, x, x, m, m);
+  };
+  if constexpr (C::n_at_compile_time == dynamic && lifts_into)
+    return detail::tree_inverse_dynamics<decltype(id), C>(std::move(id));
+  else
+    return id;
 }
 /// As inverse_dynamics on a tree, returning (τ, λ).
 template <class S, pfaffian_constraint C>

@@ -505,16 +505,25 @@ class wheeled_base {
   /// again (constraints/stages.hpp's project takes it on project ∘ rne ∘ lift).
   template <class Q, class V, class T>
   auto project_with(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v, const memo<T>& mm) const {
+    vecN<promote_t<T, typename V::Scalar>, dynamic> tau(p());
+    project_into(q, v, mm, tau);
+    return tau;
+  }
+  /// The same into tau (p entries, of the promoted scalar; a vector or a map): no allocation.
+  template <class Q, class V, class T, class Tau>
+  void project_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v, const memo<T>& mm,
+                    Eigen::MatrixBase<Tau>& tau) const {
     using R = promote_t<T, typename V::Scalar>;
+    static_assert(std::is_same_v<typename Tau::Scalar, R>, "tau's scalar is the lift's and v's promoted scalar");
+    detail::check_size(tau, p(), "tau");
     if (act_is_eta_) {  // SᵀE = I: τ = Sᵀ v
-      vecN<R, dynamic> r(m());
-      project_force(mm.data(), v, r);
-      return r;
+      project_force(mm.data(), v, tau);
+      return;
     }
     detail::wheel_buffer<R, dynamic> rb(m());
     Eigen::Map<vecN<R, dynamic>> r(rb.data(), m());
     project_force(mm.data(), v, r);
-    return vecN<R, dynamic>(actuation(q, mm.data(), r));
+    actuation_into(q, mm.data(), r, tau);
   }
 
   /// τ = the solution of (SᵀE) τ = r of least Σ w_j τ_j² (p ≥ m), for r = Sᵀ v of m rows (a
@@ -920,16 +929,21 @@ class wheeled_base {
   /// (|η ∩ W| × p_w), exactly when square, else with least Σ w τ²: τ_w = W⁻¹Bᵀ(BW⁻¹Bᵀ)⁻¹ r_w.
   template <class Q, class T, class R>
   auto actuation(const Q& q, const T* sd, const R& r) const {
+    Eigen::Matrix<promote_t<T, typename R::Scalar>, dynamic, R::ColsAtCompileTime> tau(p(), r.cols());
+    actuation_into(q, sd, r, tau);
+    return tau;
+  }
+  /// The same into tau (p × r's columns): no allocation.
+  template <class Q, class T, class R, class Out>
+  void actuation_into(const Q& q, const T* sd, const R& r, Out& tau) const {
     using U = promote_t<T, typename R::Scalar>;
-    using Out = Eigen::Matrix<U, dynamic, R::ColsAtCompileTime>;
     const int kk = k(), mw_ = mw(), pw_ = pw();
     const Eigen::Index cols = r.cols();
-    Out tau(p(), cols);
     for (const auto& [a, c] : act_eta_)
       for (Eigen::Index j = 0; j < cols; ++j) tau(a, j) = U(r(c, j));
     if (mw_ == 0) {  // the wheels allow no motion: their actuators need no torque
       for (const auto& aw : actw_) tau.row(aw.first).setZero();
-      return tau;
+      return;
     }
     // B(i, a) = S(actuator a's joint, η's wheel-path entry i)
     const bool square = pw_ == mw_;
@@ -980,7 +994,6 @@ class wheeled_base {
         }
       }
     }
-    return tau;
   }
   /// A solved dependent rate not finite: an enclosure too wide for A_D (an interval box:
   /// refused by name, not passed on as a NaN) or an overflow.
