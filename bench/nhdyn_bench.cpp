@@ -15,8 +15,8 @@
 ///   fd/<model>/{aba, aba_reference, crba_ldlt, kdl}  holonomic forward dynamics: the articulated-
 ///                                               body algorithm (kernel, reference), CRBA + LDLᵀ, KDL
 ///                                               mass matrix by the kernel and the reference
-///   nh_id/<robot>/{rne, lagrange}               a robot file's nonholonomic inverse dynamics
-///   nh_pair/<robot>/run_time                     (robot: mobile_manipulator_{ddrive, wheels,
+///   nh_id/<robot>/{rne, evaluate, lagrange}     a robot file's nonholonomic inverse dynamics (evaluate: into a reused τ)
+///   nh_pair/<robot>/{run_time, evaluate}         (robot: mobile_manipulator_{ddrive, wheels,
 ///   nh_fd/<robot>/nhdyn                          bicycle, castors}, mecanum_arm, omni3_arm,
 ///                                                castor_drive_arm, powered_castors_arm; the
 ///                                                wheels robot as a wheeled_base too) vs
@@ -701,6 +701,16 @@ void register_wheeled(const std::string& model, const nhdyn::tree<double>& t, co
     auto r = el(q, eta, eta_dot);
     benchmark::DoNotOptimize(r);
   });
+  if constexpr (requires(Eigen::VectorXd& out) { id.evaluate(q, eta, eta_dot, out); }) {
+    Eigen::VectorXd out = Eigen::VectorXd::Zero(p);
+    id.evaluate(q, eta, eta_dot, out);
+    agree(out, tau, 0.0, "nh_id/" + model + ": evaluate into a reused tau vs the call");
+    add("nh_id/" + model + "/evaluate", [id, q, eta, eta_dot, out]() mutable {
+      opaque(q), opaque(eta), opaque(eta_dot);
+      id.evaluate(q, eta, eta_dot, out);
+      benchmark::DoNotOptimize(out.data());
+    });
+  }
   const auto xi = nhdyn::lift(c)(q, eta, eta_dot);
   const Eigen::VectorXd xq = xi.q, xqd = xi.qd, xqdd = xi.qdd;
   auto rn = nhdyn::rne(t);
@@ -718,6 +728,21 @@ void register_wheeled(const std::string& model, const nhdyn::tree<double>& t, co
         auto r = id(q, eta, eta_dot);
         benchmark::DoNotOptimize(r);
       });
+  if constexpr (requires(Eigen::VectorXd& out) { id.evaluate(q, eta, eta_dot, out); }) {
+    // the same pair with both sides into storage the caller reuses (no allocator in either)
+    add_paired(
+        "nh_pair/" + model + "/evaluate",
+        [rn, xq, xqd, xqdd, v = Eigen::VectorXd(xq.size())]() mutable {
+          opaque(xq), opaque(xqd), opaque(xqdd);
+          rn.evaluate(xq, xqd, xqdd, v);
+          benchmark::DoNotOptimize(v.data());
+        },
+        [id, q, eta, eta_dot, out = Eigen::VectorXd(tau.size())]() mutable {
+          opaque(q), opaque(eta), opaque(eta_dot);
+          id.evaluate(q, eta, eta_dot, out);
+          benchmark::DoNotOptimize(out.data());
+        });
+  }
   auto fd = nhdyn::nh_forward_dynamics(t, c);
   agree(fd(q, eta, tau), eta_dot, 1e-9, "nh_fd/" + model + ": forward dynamics inverts inverse dynamics");
   add("nh_fd/" + model + "/nhdyn", [fd, q, eta, tau_in]() mutable {

@@ -116,6 +116,12 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
                f"`{ctx.get('nhdyn_flags', '?')}`; KDL {ctx.get('kdl_flags', '?')}. Every figure is the "
                f"**median of {nrep} repetitions** of the CPU time per call in nanoseconds "
                f"(Google Benchmark `cpu_time`), from `docs/performance.json`.\n")
+    if "partial_rerun" in ctx:  # some cases re-run later by a filtered run, merged by name
+        pr = ctx["partial_rerun"]
+        fams = sorted({"/".join(r.split("/")[:1]) for r in pr["run_names"]})
+        out[-1] = out[-1].rstrip("\n") + (f" The cases {', '.join(f'`{f}/…`' for f in fams)} of the robot files were "
+                                         f"re-run {pr['date']} (a filtered run, the same binary and flags; "
+                                         f"{len(pr['run_names'])} cases), and the ratios among them are of that run.\n")
 
     # ---------------------------------------------------------------- rne vs KDL
     out.append("### Holonomic rne against Orocos KDL (issue 2)\n")
@@ -273,49 +279,56 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
     out.append("### A real robot's URDF with each constraint type (issue 14)\n")
     out.append("The shipped mobile manipulator (16 URDF joints on a planar base: n = 19) from its robot files: "
                "`nh_id/<robot>/{rne, lagrange}` (the paper's method; the projected Euler–Lagrange equations on "
-               "the tree, `bench/lagrange.hpp`), `nh_pair/<robot>/run_time` (the holonomic rne at the lifted "
-               "state and the method at ζ, paired as above), `nh_fd/<robot>/nhdyn` (the constrained forward "
+               "the tree, `bench/lagrange.hpp`), `nh_id/<robot>/evaluate` (the method into a τ the caller reuses), "
+               "`nh_pair/<robot>/run_time` (the holonomic rne at the lifted "
+               "state and the method at ζ, paired as above; `nh_pair/<robot>/evaluate`: the two `evaluate` forms paired), `nh_fd/<robot>/nhdyn` (the constrained forward "
                "dynamics η̇ = M_η⁻¹(SᵀEτ − h_η)).\n")
-    out.append("| robot file | k | m | nh | paired nh / holonomic | E–L | E–L / nh | forward dynamics | allocations (nh, fd) |")
-    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---|")
-    worst_pair, least_el = 0.0, float("inf")
+    out.append("| robot file | k | m | nh | paired nh / holonomic | nh, evaluate | paired, evaluate | E–L | E–L / nh | forward dynamics | allocations (nh, nh evaluate, fd) |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+    worst_pair, worst_pair_ev, least_el = 0.0, 0.0, float("inf")
     for m, k in WHEELED:
         nh, el, fd, pr = g(f"nh_id/{m}/rne"), g(f"nh_id/{m}/lagrange"), g(f"nh_fd/{m}/nhdyn"), PAIRED.get(f"nh_pair/{m}/run_time")
         if nh is None:
             continue
+        ev, pe = g(f"nh_id/{m}/evaluate"), PAIRED.get(f"nh_pair/{m}/evaluate")
         worst_pair = max(worst_pair, pr or 0)
+        worst_pair_ev = max(worst_pair_ev, pe or 0)
         least_el = min(least_el, ratio(el, nh) or 0)
-        out.append(f"| {m} | {k} | {19 - k} | {ns(nh)} | {r2(pr)} | {ns(el)} | {ratio(el, nh):.0f} | {ns(fd)} | "
-                   f"{al(allocs.get(f'nh_id/{m}/rne'))}, {al(allocs.get(f'nh_fd/{m}/nhdyn'))} |")
+        out.append(f"| {m} | {k} | {19 - k} | {ns(nh)} | {r2(pr)} | {ns(ev)} | {r2(pe)} | {ns(el)} | {ratio(el, nh):.0f} | {ns(fd)} | "
+                   f"{al(allocs.get(f'nh_id/{m}/rne'))}, {al(allocs.get(f'nh_id/{m}/evaluate'))}, {al(allocs.get(f'nh_fd/{m}/nhdyn'))} |")
     out.append("")
     out.append(f"- Target nh ≤ {TARGET_NH}× the holonomic rne (paired): worst **{worst_pair:.2f}** — "
-               f"{verdict(worst_pair)}.")
+               f"{verdict(worst_pair)}; both into reused storage (`evaluate`): worst **{worst_pair_ev:.2f}**.")
     out.append(f"- Target nh ≥ 20× faster than projected Euler–Lagrange: least **{least_el:.0f}×** — "
                f"{'met' if least_el >= 20 else 'NOT met'}.")
     out.append("")
     # ---------------------------------------------------------------- every wheeled base (issue 31)
     out.append("### Every wheeled base: wheeled_base on the shipped bases (issue 31)\n")
     out.append("The shipped robot files with a `wheeled_base` constraint (docs/model-format.md): the same cases as above "
-               "(`nh_id/<robot>/{rne, lagrange}`, `nh_pair/<robot>/run_time`, `nh_fd/<robot>/nhdyn`), with the "
+               "(`nh_id/<robot>/{rne, evaluate, lagrange}`, `nh_pair/<robot>/{run_time, evaluate}`, `nh_fd/<robot>/nhdyn`), with the "
                "redundancy resolution (the least-norm τ of p > m actuators) inside the nonholonomic call, and "
                "`deriv_nh_pair/<robot>` (the analytic ∂τ/∂ζ, paired with one call). The last row is "
                "mobile_manipulator_wheels' two drive wheels as a `wheeled_base` (the `wheels` type above is its "
                "closed-form instance).\n")
-    out.append("| robot file | n | k | m | p | nh | paired nh / holonomic | E–L | E–L / nh | forward dynamics | ∂τ/∂ζ / nh (paired) | allocations (nh, fd) |")
-    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
-    worst_wp, least_wel = 0.0, float("inf")
+    out.append("| robot file | n | k | m | p | nh | paired nh / holonomic | nh, evaluate | paired, evaluate | E–L | E–L / nh | forward dynamics | ∂τ/∂ζ / nh (paired) | allocations (nh, nh evaluate, fd) |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+    worst_wp, worst_wpe, least_wel = 0.0, 0.0, float("inf")
     for m, n_, k_, m_, p_ in WHEEL_BASES:
         nh, el, fd, pr = g(f"nh_id/{m}/rne"), g(f"nh_id/{m}/lagrange"), g(f"nh_fd/{m}/nhdyn"), PAIRED.get(f"nh_pair/{m}/run_time")
         if nh is None:
             continue
+        ev, pe = g(f"nh_id/{m}/evaluate"), PAIRED.get(f"nh_pair/{m}/evaluate")
         if m != "mobile_manipulator_wheels_as_wheeled_base":
             worst_wp = max(worst_wp, pr or 0)
+            worst_wpe = max(worst_wpe, pe or 0)
             least_wel = min(least_wel, ratio(el, nh) or 0)
-        out.append(f"| {m} | {n_} | {k_} | {m_} | {p_} | {ns(nh)} | {r2(pr)} | {ns(el)} | {ratio(el, nh):.0f} | {ns(fd)} | "
-                   f"{r2(PAIRED.get(f'deriv_nh_pair/{m}'))} | {al(allocs.get(f'nh_id/{m}/rne'))}, {al(allocs.get(f'nh_fd/{m}/nhdyn'))} |")
+        out.append(f"| {m} | {n_} | {k_} | {m_} | {p_} | {ns(nh)} | {r2(pr)} | {ns(ev)} | {r2(pe)} | {ns(el)} | {ratio(el, nh):.0f} | {ns(fd)} | "
+                   f"{r2(PAIRED.get(f'deriv_nh_pair/{m}'))} | {al(allocs.get(f'nh_id/{m}/rne'))}, {al(allocs.get(f'nh_id/{m}/evaluate'))}, {al(allocs.get(f'nh_fd/{m}/nhdyn'))} |")
     out.append("")
     out.append(f"- Target nh ≤ {TARGET_WHEEL_NH}× the holonomic rne (paired, redundancy resolution included): worst "
-               f"**{worst_wp:.2f}** — {'met' if 0 < worst_wp <= TARGET_WHEEL_NH else 'NOT met'}.")
+               f"**{worst_wp:.2f}** — {'met' if 0 < worst_wp <= TARGET_WHEEL_NH else 'NOT met'}; both into reused "
+               f"storage (`nh_pair/<robot>/evaluate`: rne's and the method's `evaluate`): worst **{worst_wpe:.2f}** — "
+               f"{'met' if 0 < worst_wpe <= TARGET_WHEEL_NH else 'NOT met'}.")
     out.append(f"- Target nh ≥ {TARGET_WHEEL_EL}× faster than projected Euler–Lagrange: least **{least_wel:.0f}×** — "
                f"{'met' if least_wel >= TARGET_WHEEL_EL else 'NOT met'} (E–L costs O(n⁴), the method O(n): the ratio "
                f"grows with n, and below n ≈ 19 it is bounded by E–L / rne itself).")

@@ -165,15 +165,21 @@ struct bicycle {
   /// Sᵀ v without forming S.
   template <class Q, class V>
   auto St_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
+    vecN<promote_t<promote_t<Sc, typename Q::Scalar>, typename V::Scalar>, m_at_compile_time> out(n - 2);
+    St_times_into(q, v, out);
+    return out;
+  }
+  /// The same into out (m entries, of the promoted scalar; a vector or a map): no allocation.
+  template <class Q, class V, class Out>
+  void St_times_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v, Eigen::MatrixBase<Out>& out) const {
     using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename V::Scalar>;
+    static_assert(std::is_same_v<typename Out::Scalar, T>, "out's scalar is the promoted scalar of q and v");
     const auto p = detail::sincos_of(T(q(heading)));
     const auto d = steering(T(q(steer)));
-    vecN<T, m_at_compile_time> out(n - 2);
     out(0) = p.c * T(v(x)) + p.s * T(v(y)) + T(v(heading)) * d.s / (T(wheelbase) * d.c);
     out(1) = T(v(steer));
     for (int j = 0, c = 2; j < n; ++j)
       if (!is_base_or_steer(j)) out(c++) = T(v(j));
-    return out;
   }
   /// Ṡ(q, q̇) η: only the v column moves: d/dt (cos ψ, sin ψ, tan δ / L) =
   /// (−sin ψ ψ̇, cos ψ ψ̇, δ̇ / (L cos² δ)), δ̇ = steer_sign·q̇_steer.

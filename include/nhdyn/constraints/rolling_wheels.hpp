@@ -186,17 +186,23 @@ struct rolling_wheels {
   /// Sᵀ v without forming S.
   template <class Q, class V>
   auto St_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
+    vecN<promote_t<promote_t<Sc, typename Q::Scalar>, typename V::Scalar>, m_at_compile_time> out(n - 3);
+    St_times_into(q, v, out);
+    return out;
+  }
+  /// The same into out (m entries, of the promoted scalar; a vector or a map): no allocation.
+  template <class Q, class V, class Out>
+  void St_times_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v, Eigen::MatrixBase<Out>& out) const {
     using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename V::Scalar>;
+    static_assert(std::is_same_v<typename Out::Scalar, T>, "out's scalar is the promoted scalar of q and v");
     const auto p = detail::sincos_of(T(q(heading)));
     const wheel_map k = map();
     // v seen in the base frame: forward and lateral components of (v_x, v_y).
     const T fu = p.c * T(v(x)) + p.s * T(v(y)), fl = -p.s * T(v(x)) + p.c * T(v(y)), fw = T(v(heading));
-    vecN<T, m_at_compile_time> out(n - 3);
     out(0) = T(k.uL) * fu + T(k.lL) * fl + T(k.wL) * fw + T(v(left));
     out(1) = T(k.uR) * fu + T(k.lR) * fl + T(k.wR) * fw + T(v(right));
     for (int j = 0, c = 2; j < n; ++j)
       if (!is_base_or_wheel(j)) out(c++) = T(v(j));
-    return out;
   }
   /// Ṡ(q, q̇) η: only the x and y rows move (they turn with ψ, ψ̇ = q̇_heading).
   template <class Q, class QD, class Et>

@@ -213,8 +213,9 @@ class project_fn : public stage_tag {
   }
   /// τ into tau (actuator_count entries, of the promoted scalar) from (q, v) and the lift's
   /// memo: the call above's numbers, bit for bit. Without allocation where the constraint
-  /// projects into given storage (wheeled_base's project_into; an orthonormal S's
-  /// St_times_into); else τ is formed as the call on (q, v) forms it and copied.
+  /// projects into given storage (wheeled_base's project_into; Sᵀv into given storage where
+  /// τ = Sᵀv: differential_drive with the memo, rolling_wheels and bicycle from q); else τ
+  /// is formed as the call on (q, v) forms it and copied.
   template <class Q, class V, class Memo, class Tau>
   void into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v, const Memo& memo,
             Eigen::MatrixBase<Tau>& tau) const {
@@ -224,6 +225,8 @@ class project_fn : public stage_tag {
       c_.project_into(q, v, memo, tau);
     else if constexpr (C::orthonormal_S && !has_input_map<C, Q> && requires { c_.St_times_into(v, memo, tau); })
       c_.St_times_into(v, memo, tau);  // SᵀS = I: Sᵀv is τ
+    else if constexpr (detail::projection_is_St<C, Q> && requires { c_.St_times_into(q, v, tau); })
+      c_.St_times_into(q, v, tau);  // SᵀE = I (or SᵀS = I, no E): Sᵀv is τ, as apply_St forms it
     else
       tau = detail::solve_StE(c_, q, apply_St(c_, q, v));
   }
@@ -348,8 +351,7 @@ namespace detail {
 /// `evaluate(q, η, η̇, τ)`, the same three stages into storage: lift.into writes ξ's q̇ and q̈
 /// into stack scratch (heap beyond 256 joints), rne.evaluate writes v over q̈, project.into
 /// writes τ into the caller's vector. No allocation where the constraint lifts and projects
-/// into given storage (wheeled_base with k·|η ∩ W| ≤ 24, differential_drive); the others
-/// allocate their projection's solve (bicycle, rolling_wheels: (SᵀS)⁻¹).
+/// into given storage (every built-in base constraint; wheeled_base with k·|η ∩ W| ≤ 24).
 template <class Composed, class C>
 struct tree_inverse_dynamics : Composed {
   explicit tree_inverse_dynamics(Composed c) : Composed(std::move(c)) {}
@@ -368,8 +370,8 @@ struct tree_inverse_dynamics : Composed {
                                                       typename ED::Scalar>>,
                   "tau's scalar is the promoted scalar of the constraint, q, eta and eta_dot");
     const int n = dynamics.dof();
-    small_buffer<T, dynamic, 256> qd_store(n), v_store(n);
-    Eigen::Map<vecN<T, dynamic>> qd(qd_store.data(), n), v(v_store.data(), n);
+    small_buffer<T, dynamic, 512> store(2 * n);  // q̇, then q̈ and v
+    Eigen::Map<vecN<T, dynamic>> qd(store.data(), n), v(store.data() + n, n);
     const auto memo = lifting.into(q, eta, eta_dot, qd, v);  // q̈ into v's storage
     dynamics.evaluate(q, qd, v, v);                          // v over q̈
     projection.into(q, v, memo, tau);
