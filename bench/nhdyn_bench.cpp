@@ -701,7 +701,9 @@ void register_wheeled(const std::string& model, const nhdyn::tree<double>& t, co
     auto r = el(q, eta, eta_dot);
     benchmark::DoNotOptimize(r);
   });
-  if constexpr (requires(Eigen::VectorXd& out) { id.evaluate(q, eta, eta_dot, out); }) {
+  // the method into a τ the caller reuses (inverse_dynamics on a tree: every built-in constraint)
+  constexpr bool has_evaluate = requires(Eigen::VectorXd& out) { id.evaluate(q, eta, eta_dot, out); };
+  if constexpr (has_evaluate) {
     Eigen::VectorXd out = Eigen::VectorXd::Zero(p);
     id.evaluate(q, eta, eta_dot, out);
     agree(out, tau, 0.0, "nh_id/" + model + ": evaluate into a reused tau vs the call");
@@ -728,7 +730,7 @@ void register_wheeled(const std::string& model, const nhdyn::tree<double>& t, co
         auto r = id(q, eta, eta_dot);
         benchmark::DoNotOptimize(r);
       });
-  if constexpr (requires(Eigen::VectorXd& out) { id.evaluate(q, eta, eta_dot, out); }) {
+  if constexpr (has_evaluate) {
     // the same pair with both sides into storage the caller reuses (no allocator in either)
     add_paired(
         "nh_pair/" + model + "/evaluate",
