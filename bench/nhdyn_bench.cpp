@@ -17,7 +17,7 @@
 ///                                               mass matrix by the kernel and the reference
 ///   nh_id/<robot>/{rne, evaluate, lagrange}     a robot file's nonholonomic inverse dynamics (evaluate: into a reused τ)
 ///   nh_pair/<robot>/{run_time, evaluate}         (robot: mobile_manipulator_{ddrive, wheels,
-///   nh_fd/<robot>/nhdyn                          bicycle, castors}, mecanum_arm, omni3_arm,
+///   nh_fd/<robot>/{nhdyn, evaluate}              bicycle, castors}, mecanum_arm, omni3_arm,
 ///                                                castor_drive_arm, powered_castors_arm; the
 ///                                                wheels robot as a wheeled_base too) vs
 ///                                                projected E–L on the tree, paired
@@ -751,6 +751,15 @@ void register_wheeled(const std::string& model, const nhdyn::tree<double>& t, co
     opaque(q), opaque(eta), opaque(tau_in);
     auto r = fd(q, eta, tau_in);
     benchmark::DoNotOptimize(r);
+  });
+  // the same into a result the caller reuses (η̇, M, S, M_η and its factor)
+  nhdyn::nh_forward_dynamics_result<double> fout;
+  fd.evaluate(q, eta, tau_in, fout);
+  agree(fout.eta_dot, fd(q, eta, tau_in), 0.0, "nh_fd/" + model + ": evaluate into a reused result vs the call");
+  add("nh_fd/" + model + "/evaluate", [fd, q, eta, tau_in, fout]() mutable {
+    opaque(q), opaque(eta), opaque(tau_in);
+    fd.evaluate(q, eta, tau_in, fout);
+    benchmark::DoNotOptimize(fout.eta_dot.data());
   });
 }
 

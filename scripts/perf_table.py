@@ -282,9 +282,9 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
                "the tree, `bench/lagrange.hpp`), `nh_id/<robot>/evaluate` (the method into a τ the caller reuses), "
                "`nh_pair/<robot>/run_time` (the holonomic rne at the lifted "
                "state and the method at ζ, paired as above; `nh_pair/<robot>/evaluate`: the two `evaluate` forms paired), `nh_fd/<robot>/nhdyn` (the constrained forward "
-               "dynamics η̇ = M_η⁻¹(SᵀEτ − h_η)).\n")
-    out.append("| robot file | k | m | nh | paired nh / holonomic | nh, evaluate | paired, evaluate | E–L | E–L / nh | forward dynamics | allocations (nh, nh evaluate, fd) |")
-    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+               "dynamics η̇ = M_η⁻¹(SᵀEτ − h_η)) and `nh_fd/<robot>/evaluate` (the same into a result the caller reuses).\n")
+    out.append("| robot file | k | m | nh | paired nh / holonomic | nh, evaluate | paired, evaluate | E–L | E–L / nh | forward dynamics | fd, evaluate | allocations (nh, nh evaluate, fd, fd evaluate) |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
     worst_pair, worst_pair_ev, least_el = 0.0, 0.0, float("inf")
     for m, k in WHEELED:
         nh, el, fd, pr = g(f"nh_id/{m}/rne"), g(f"nh_id/{m}/lagrange"), g(f"nh_fd/{m}/nhdyn"), PAIRED.get(f"nh_pair/{m}/run_time")
@@ -294,8 +294,9 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
         worst_pair = max(worst_pair, pr or 0)
         worst_pair_ev = max(worst_pair_ev, pe or 0)
         least_el = min(least_el, ratio(el, nh) or 0)
-        out.append(f"| {m} | {k} | {19 - k} | {ns(nh)} | {r2(pr)} | {ns(ev)} | {r2(pe)} | {ns(el)} | {ratio(el, nh):.0f} | {ns(fd)} | "
-                   f"{al(allocs.get(f'nh_id/{m}/rne'))}, {al(allocs.get(f'nh_id/{m}/evaluate'))}, {al(allocs.get(f'nh_fd/{m}/nhdyn'))} |")
+        out.append(f"| {m} | {k} | {19 - k} | {ns(nh)} | {r2(pr)} | {ns(ev)} | {r2(pe)} | {ns(el)} | {ratio(el, nh):.0f} | {ns(fd)} | {ns(g(f"nh_fd/{m}/evaluate"))} | "
+                   f"{al(allocs.get(f'nh_id/{m}/rne'))}, {al(allocs.get(f'nh_id/{m}/evaluate'))}, {al(allocs.get(f'nh_fd/{m}/nhdyn'))}, "
+                   f"{al(allocs.get(f'nh_fd/{m}/evaluate'))} |")
     out.append("")
     out.append(f"- Target nh ≤ {TARGET_NH}× the holonomic rne (paired): worst **{worst_pair:.2f}** — "
                f"{verdict(worst_pair)}; both into reused storage (`evaluate`): " +
@@ -306,13 +307,13 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
     # ---------------------------------------------------------------- every wheeled base (issue 31)
     out.append("### Every wheeled base: wheeled_base on the shipped bases (issue 31)\n")
     out.append("The shipped robot files with a `wheeled_base` constraint (docs/model-format.md): the same cases as above "
-               "(`nh_id/<robot>/{rne, evaluate, lagrange}`, `nh_pair/<robot>/{run_time, evaluate}`, `nh_fd/<robot>/nhdyn`), with the "
+               "(`nh_id/<robot>/{rne, evaluate, lagrange}`, `nh_pair/<robot>/{run_time, evaluate}`, `nh_fd/<robot>/{nhdyn, evaluate}`), with the "
                "redundancy resolution (the least-norm τ of p > m actuators) inside the nonholonomic call, and "
                "`deriv_nh_pair/<robot>` (the analytic ∂τ/∂ζ, paired with one call). The last row is "
                "mobile_manipulator_wheels' two drive wheels as a `wheeled_base` (the `wheels` type above is its "
                "closed-form instance).\n")
-    out.append("| robot file | n | k | m | p | nh | paired nh / holonomic | nh, evaluate | paired, evaluate | E–L | E–L / nh | forward dynamics | ∂τ/∂ζ / nh (paired) | allocations (nh, nh evaluate, fd) |")
-    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+    out.append("| robot file | n | k | m | p | nh | paired nh / holonomic | nh, evaluate | paired, evaluate | E–L | E–L / nh | forward dynamics | fd, evaluate | ∂τ/∂ζ / nh (paired) | allocations (nh, nh evaluate, fd, fd evaluate) |")
+    out.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
     worst_wp, worst_wpe, least_wel = 0.0, 0.0, float("inf")
     for m, n_, k_, m_, p_ in WHEEL_BASES:
         nh, el, fd, pr = g(f"nh_id/{m}/rne"), g(f"nh_id/{m}/lagrange"), g(f"nh_fd/{m}/nhdyn"), PAIRED.get(f"nh_pair/{m}/run_time")
@@ -323,8 +324,9 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
             worst_wp = max(worst_wp, pr or 0)
             worst_wpe = max(worst_wpe, pe or 0)
             least_wel = min(least_wel, ratio(el, nh) or 0)
-        out.append(f"| {m} | {n_} | {k_} | {m_} | {p_} | {ns(nh)} | {r2(pr)} | {ns(ev)} | {r2(pe)} | {ns(el)} | {ratio(el, nh):.0f} | {ns(fd)} | "
-                   f"{r2(PAIRED.get(f'deriv_nh_pair/{m}'))} | {al(allocs.get(f'nh_id/{m}/rne'))}, {al(allocs.get(f'nh_id/{m}/evaluate'))}, {al(allocs.get(f'nh_fd/{m}/nhdyn'))} |")
+        out.append(f"| {m} | {n_} | {k_} | {m_} | {p_} | {ns(nh)} | {r2(pr)} | {ns(ev)} | {r2(pe)} | {ns(el)} | {ratio(el, nh):.0f} | {ns(fd)} | {ns(g(f"nh_fd/{m}/evaluate"))} | "
+                   f"{r2(PAIRED.get(f'deriv_nh_pair/{m}'))} | {al(allocs.get(f'nh_id/{m}/rne'))}, {al(allocs.get(f'nh_id/{m}/evaluate'))}, "
+                   f"{al(allocs.get(f'nh_fd/{m}/nhdyn'))}, {al(allocs.get(f'nh_fd/{m}/evaluate'))} |")
     out.append("")
     out.append(f"- Target nh ≤ {TARGET_WHEEL_NH}× the holonomic rne (paired, redundancy resolution included): worst "
                f"**{worst_wp:.2f}** — {'met' if 0 < worst_wp <= TARGET_WHEEL_NH else 'NOT met'}; both into reused "

@@ -387,6 +387,66 @@ TEST_CASE("inverse_dynamics on a tree: evaluate into a reused tau = the composit
   }
 }
 
+TEST_CASE("nh_forward_dynamics on a tree: evaluate into one reused result = the plain call bit for bit, for every "
+          "robot file's constraint; η̇ against dense SᵀMS and Eigen's LDLT, and against the inverse dynamics",
+          "[wheel_kinds]") {
+  std::mt19937 rng(2027);
+  nh_forward_dynamics_result<double> out;  // one result for every file: sizes change from file to file
+  for (const char* file : {"mobile_manipulator.json", "mobile_manipulator_wheels.json", "mobile_manipulator_bicycle.json",
+                           "mobile_manipulator_castors.json", "mecanum_arm.json", "omni3_arm.json",
+                           "castor_drive_arm.json", "powered_castors_arm.json", "tiago_style.json"}) {
+    INFO(file);
+    const auto r = load(file);
+    std::visit(
+        [&](const auto& c) {
+          const auto fd = nh_forward_dynamics(r.model, c);
+          const auto id = inverse_dynamics(r.model, c);
+          const int n = c.dof(), m = c.m(), p = actuator_count(c);
+          for (int trial = 0; trial < 3; ++trial) {
+            const VectorXd q = random_q(n, rng), eta = random_vec(m, rng), eta_dot = random_vec(m, rng, 2);
+            const VectorXd tau = id(q, eta, eta_dot);
+            fd.evaluate(q, eta, tau, out);
+            const VectorXd call = fd(q, eta, tau);
+            REQUIRE(out.eta_dot.size() == m);
+            CHECK((out.eta_dot.array() == call.array()).all());
+            // the inverse dynamics' τ gives back its η̇ (the least-norm τ too: SᵀEτ is what it solves)
+            CHECK((out.eta_dot - eta_dot).norm() <= 1e-9 * (1 + eta_dot.norm()));
+            // the fields against dense products of the constraint's own S(q), E(q) and the CRBA's M(q)
+            const MatrixXd S = c.S(q), E = input_map(c, q), M = mass_matrix(r.model)(q);
+            CHECK((out.S.array() == S.array()).all());
+            CHECK((out.mass.array() == M.array()).all());
+            const MatrixXd Me = S.transpose() * M * S;
+            CHECK((out.reduced_inertia - Me).norm() <= 1e-13 * Me.norm());
+            const VectorXd h = fd.reduced_bias(q, eta);
+            CHECK((out.reduced_bias - h).norm() <= 1e-12 * (1 + h.norm()));
+            const VectorXd u = S.transpose() * E * tau;
+            CHECK((out.actuation - u).norm() <= 1e-12 * (1 + u.norm()));
+            const VectorXd ref = Me.ldlt().solve(u - h);
+            CHECK((out.eta_dot - ref).norm() <= 1e-9 * (1 + ref.norm()));
+          }
+          // duals along τ: values and derivatives as the plain call's
+          using D = dual<double, 1>;
+          const VectorXd q = random_q(n, rng), eta = random_vec(m, rng), tau = random_vec(p, rng, 3);
+          vecN<D, dynamic> td(p);
+          for (int j = 0; j < p; ++j) td(j) = D(tau(j), {j == 0 ? 1.0 : 0.0});
+          nh_forward_dynamics_result<D> dout;
+          fd.evaluate(q, eta, td, dout);
+          const vecN<D, dynamic> dc = fd(q, eta, td);
+          for (int j = 0; j < m; ++j) {
+            CHECK(dout.eta_dot(j).value() == dc(j).value());
+            CHECK(dout.eta_dot(j).derivative(0) == dc(j).derivative(0));
+          }
+          // errors: the caller's names
+          VectorXd bad = eta;
+          bad(0) = std::numeric_limits<double>::quiet_NaN();
+          CHECK_THROWS_WITH(fd.evaluate(q, eta, VectorXd(tau.head(p - 1)), out), Catch::Matchers::Contains("tau"));
+          CHECK_THROWS_WITH(fd.evaluate(q, bad, tau, out), Catch::Matchers::Contains("eta"));
+          CHECK_THROWS_WITH(fd.evaluate(VectorXd(q.head(n - 1)), eta, tau, out), Catch::Matchers::Contains("q"));
+        },
+        *r.constraint);
+  }
+}
+
 TEST_CASE("wheeled_base: the forward dynamics' A, B (analytic and by duals) = central differences of the forward dynamics",
           "[wheel_kinds]") {
   // with more actuators than η (mecanum, powered castors) ∂η̇/∂x has the term (∂B/∂x)(τ − τ_id):

@@ -63,6 +63,10 @@ concept has_S_into = requires(const C& c, const Q& q, Mat& s) { c.S_into(q, s); 
 /// Optional: Sᵀ v without forming S.
 template <class C, class Q, class V>
 concept has_St_times = requires(const C& c, const Q& q, const V& v) { c.St_times(q, v); };
+/// Optional: E τ into given storage (n entries) without forming E (wheeled_base: τ at the
+/// actuated joints, zeros elsewhere).
+template <class C, class Q, class Tau, class Out>
+concept has_E_times_into = requires(const C& c, const Q& q, const Tau& tau, Out& out) { c.E_times_into(q, tau, out); };
 /// Optional: Ṡ η without forming Ṡ.
 template <class C, class Q, class QD, class E>
 concept has_Sdot_times = requires(const C& c, const Q& q, const QD& qd, const E& eta) { c.Sdot_times(q, qd, eta); };
@@ -152,16 +156,86 @@ auto S_by_S_into(const C& c, const Eigen::MatrixBase<Q>& q) {
   return s;
 }
 
+/// The entries of an n × m matrix S that the products below read, by column: column c's rows
+/// are rows[start[c]] … rows[start[c + 1] − 1]. For a floating-point S they are its nonzero
+/// entries (a term 0·x adds nothing where x is finite: the products equal the dense ones up to
+/// rounding order), else every entry (a dual or an interval whose value is 0 may carry a
+/// derivative or a width). Storage is fixed-size when n and m are.
+template <int N, int M>
+struct column_pattern {
+  static constexpr int NM = N == dynamic || M == dynamic ? dynamic : N * M;
+  Eigen::Matrix<int, NM, 1> rows;
+  Eigen::Matrix<int, M == dynamic ? dynamic : M + 1, 1> start;
+
+  template <class SM>
+  void scan(const Eigen::MatrixBase<SM>& S) {
+    using T = typename SM::Scalar;
+    const int n = static_cast<int>(S.rows()), m = static_cast<int>(S.cols());
+    if (rows.size() != n * m) rows.resize(n * m);
+    if (start.size() != m + 1) start.resize(m + 1);
+    int k = 0;
+    for (int c = 0; c < m; ++c) {
+      start(c) = k;
+      if constexpr (std::is_floating_point_v<T>) {
+        for (int i = 0; i < n; ++i) {  // branch-free: S's zeros are not predictable
+          rows(k) = i;
+          k += S(i, c) != T(0);
+        }
+      } else {
+        for (int i = 0; i < n; ++i) rows(k++) = i;
+      }
+    }
+    start(m) = k;
+  }
+  /// out = Sᵀ v (m entries): O(nonzeros of S).
+  template <class SM, class V, class Out>
+  void St_times(const Eigen::MatrixBase<SM>& S, const Eigen::MatrixBase<V>& v, Eigen::MatrixBase<Out>& out) const {
+    for (int c = 0; c + 1 < start.size(); ++c) {
+      typename Out::Scalar a(0);
+      for (int k = start(c); k < start(c + 1); ++k) a += S(rows(k), c) * v(rows(k));
+      out(c) = a;
+    }
+  }
+  /// Me = Sᵀ M S for a symmetric n × n M (m × m, exactly symmetric), through MS (n × m scratch):
+  /// MS's column b = Σ M's columns j of S's column b's nonzeros, then Me(a, b) for a ≥ b.
+  /// O(n·nnz(S) + m·nnz(S)) against the dense O(n²m).
+  template <class SM, class MM, class WS, class ME>
+  void St_M_S(const Eigen::MatrixBase<SM>& S, const Eigen::MatrixBase<MM>& Mq, Eigen::MatrixBase<WS>& MS,
+              Eigen::MatrixBase<ME>& Me) const {
+    using T = typename ME::Scalar;
+    const int m = static_cast<int>(start.size()) - 1;
+    for (int b = 0; b < m; ++b) {
+      auto col = MS.col(b);
+      col.setZero();
+      for (int k = start(b); k < start(b + 1); ++k) col += S(rows(k), b) * Mq.col(rows(k));
+    }
+    for (int b = 0; b < m; ++b)
+      for (int a = b; a < m; ++a) {
+        T e(0);
+        for (int k = start(a); k < start(a + 1); ++k) e += S(rows(k), a) * MS(rows(k), b);
+        Me(a, b) = e;
+        Me(b, a) = e;
+      }
+  }
+};
+
 /// Sᵀ M S in the scalar T for a symmetric M: the constraint's structured `St_M_S` when it has
-/// one (differential_drive: O(n²)), else dense products (O(n²m)).
+/// one (differential_drive: O(n²)), else S's nonzero columns against M (column_pattern:
+/// O(n·nnz(S)), the dense product's O(n²m) where S is dense).
 template <class T, class C, class Q, class MM>
 matrix<T, C::m_at_compile_time, C::m_at_compile_time> project_inertia(const C& c, const Eigen::MatrixBase<Q>& q,
                                                                       const Eigen::MatrixBase<MM>& M) {
   if constexpr (has_St_M_S<C, Q, MM>) {
     return c.St_M_S(q, M).template cast<T>();
   } else {
-    const auto S = c.S(q);
-    return (S.transpose().template cast<T>() * M.template cast<T>() * S.template cast<T>());
+    constexpr int N = C::n_at_compile_time, Mc = C::m_at_compile_time;
+    const matrix<T, N, Mc> S = c.S(q).template cast<T>();
+    column_pattern<N, Mc> p;
+    p.scan(S);
+    matrix<T, N, Mc> MS(S.rows(), S.cols());
+    matrix<T, Mc, Mc> Me(S.cols(), S.cols());
+    p.St_M_S(S, M.template cast<T>(), MS, Me);
+    return Me;
   }
 }
 }  // namespace detail

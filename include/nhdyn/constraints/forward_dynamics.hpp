@@ -19,6 +19,25 @@ namespace nhdyn {
 
 enum class reduced_inertia_method { crba, rne_columns };
 
+/// What `nh_forward_dynamics_fn::evaluate` writes: η̇ and the quantities that form it, in
+/// storage the caller reuses from call to call (no allocation after the first call of a size,
+/// docs/api.md §6). T: the model's and the inputs' promoted scalar.
+template <class T, int N = dynamic, int M = dynamic>
+struct nh_forward_dynamics_result {
+  vecN<T, M> eta_dot;               ///< η̇ = M_η⁻¹ (SᵀE τ − h_η)
+  matrix<T, N, M> S;                ///< S(q), n × m
+  matrix<T, N, N> mass;             ///< M(q), n × n (reduced_inertia_method::crba; else not written)
+  matrix<T, M, M> reduced_inertia;  ///< M_η = Sᵀ M S, m × m
+  ldlt<T, M> factor;                ///< M_η's LDLᵀ (factor.pivot_ratio(): a cheap lower bound of cond M_η)
+  vecN<T, M> reduced_bias;          ///< h_η = Sᵀ (rne(q, Sη, Ṡη) + τ_f(Sη) − Q_ext(q))
+  vecN<T, M> actuation;             ///< SᵀE τ: M_η η̇ = actuation − reduced_bias
+  vecN<T, N> qd;                    ///< q̇ = S η
+  // scratch (no meaning between calls)
+  vecN<T, N> sdeta, v;
+  matrix<T, N, M> MS;
+  detail::column_pattern<N, M> pattern;
+};
+
 /// Model: a chain<S, N> or a tree<S> (N = dynamic): whatever rne(model) and
 /// mass_matrix(model) take.
 template <class S, int N, pfaffian_constraint C, class Model = chain<S, N>>
@@ -116,6 +135,27 @@ class nh_forward_dynamics_fn : public stage_tag {
     return solve(q, eta, tau, &Qx);
   }
 
+  /// η̇ into `out.eta_dot`, with M(q), S(q), M_η, its factor, h_η and SᵀEτ beside it (the
+  /// result's fields), in storage reused from call to call: no heap allocation after the first
+  /// call of a size on a tree, with every constraint a robot file makes (differential_drive,
+  /// rolling_wheels, bicycle, wheeled_base) and the crba method (default). Friction's τ_f(q̇),
+  /// applied forces' Q_ext(q), `holonomic`'s and `user_constraint`'s S(q) and the rne_columns
+  /// method allocate their own results. The same numbers as the plain call, bit for bit (the
+  /// plain call is this into a new result). `out` must not alias the inputs.
+  template <class Q, class E, class TAU, class T>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
+                nh_forward_dynamics_result<T, N, M>& out) const {
+    solve_into(q, eta, tau, static_cast<const vecN<T, N>*>(nullptr), out);
+  }
+  /// …with applied forces (their Q_ext(q) is allocated by the applied-forces object).
+  template <class Q, class E, class TAU, applied_forces F, class T>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
+                const F& fx, nh_forward_dynamics_result<T, N, M>& out) const {
+    detail::check_size(q, c_.dof(), "q");
+    const auto Qx = fx.generalized_force(q);
+    solve_into(q, eta, tau, &Qx, out);
+  }
+
   /// The state derivative for integrators: x = (q, η) ↦ ẋ = (q̇, η̇) = (S η, η̇), n + m entries.
   template <class Q, class E, class TAU>
   auto state_derivative(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
@@ -134,32 +174,94 @@ class nh_forward_dynamics_fn : public stage_tag {
   auto solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
              const QX* Qx) const {
     using T0 = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
-    using T = promote_t<T0, typename QX::Scalar>;
+    nh_forward_dynamics_result<promote_t<T0, typename QX::Scalar>, N, M> out;
+    solve_into(q, eta, tau, Qx, out);
+    return std::move(out.eta_dot);
+  }
+
+  /// The forward dynamics into out: S(q); M(q) (CRBA) and M_η = SᵀMS over S's nonzeros;
+  /// h_η = Sᵀ(rne(q, Sη, Ṡη) + τ_f − Q_ext) with (q̇, Ṡη) from one lift at η̇ = 0; SᵀEτ; then
+  /// LDLᵀ of M_η and the solve, each into out's storage.
+  template <class Q, class E, class TAU, class QX, class T>
+  void solve_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
+                  const QX* Qx, nh_forward_dynamics_result<T, N, M>& out) const {
+    using T0 = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
+    static_assert(std::is_same_v<T, promote_t<T0, typename QX::Scalar>>,
+                  "the result's scalar is the model's and the inputs' promoted scalar");
     detail::check_size(q, c_.dof(), "q");
     detail::check_size(eta, c_.m(), "eta");
     detail::check_size(tau, actuator_count(c_), "tau");
     detail::check_finite(q, "q");
     detail::check_finite(eta, "eta");
     detail::check_finite(tau, "tau");
-    const vecN<T0, M> h = reduced_bias(q, eta);
-    vecN<T, M> u;
-    constexpr bool has_E = has_input_map<C, Q>;
-    if constexpr (has_identity_StE<C>) {
-      u = tau.template cast<T>();
-    } else if constexpr (has_E) {
-      u = (c_.S(q).transpose() * c_.E(q)).template cast<T>() * tau.template cast<T>();
-    } else if constexpr (C::orthonormal_S) {
-      u = tau.template cast<T>();
+    const int n = c_.dof(), m = c_.m();
+    using SMat = matrix<T, N, M>;
+    // S(q): zeros, then the entries the constraint writes (S_into), or the constraint's S(q)
+    if constexpr (has_S_into<C, Q, SMat>) {
+      out.S.setZero(n, m);
+      c_.S_into(q, out.S);
     } else {
-      const auto Sq = c_.S(q);
-      u = (Sq.transpose() * Sq).template cast<T>() * tau.template cast<T>();
+      out.S = c_.S(q).template cast<T>();
     }
-    if (Qx) u += apply_St(c_, q, *Qx).template cast<T>();
-    if (friction_) u -= apply_St(c_, q, (*friction_)(apply_S(c_, q, eta))).template cast<T>();
-    const auto f = ldlt_factor<T, M>(reduced_inertia(q), "the reduced inertia M_η = SᵀMS");
-    vecN<T, M> eta_dot = f.solve(u - h.template cast<T>());
-    detail::check_overflow(eta_dot, "nh_forward_dynamics");
-    return eta_dot;
+    out.pattern.scan(out.S);
+    // M(q) and M_η = SᵀMS
+    out.reduced_inertia.resize(m, m);
+    if (method_ == reduced_inertia_method::crba) {
+      if constexpr (std::is_same_v<T, promote_t<S, typename Q::Scalar>> && requires { M_.evaluate(q, out.mass); })
+        M_.evaluate(q, out.mass);
+      else
+        out.mass = M_(q).template cast<T>();
+      if constexpr (M != dynamic && has_St_M_S<C, Q, matrix<T, N, N>>) {
+        out.reduced_inertia = c_.St_M_S(q, out.mass).template cast<T>();  // structured, fixed-size
+      } else {
+        out.MS.resize(n, m);
+        out.pattern.St_M_S(out.S, out.mass, out.MS, out.reduced_inertia);
+      }
+    } else {
+      out.reduced_inertia = reduced_inertia(q).template cast<T>();
+    }
+    // q̇ and Ṡη: one lift at η̇ = 0 into given storage where the constraint has it (wheeled_base
+    // has no other Ṡη: its Ṡ would be S's dual derivative, a dense n × m matrix); then
+    // v = rne(q, q̇, Ṡη) (+ τ_f − Q_ext)
+    out.qd.resize(n);
+    out.sdeta.resize(n);
+    if constexpr (requires { c_.lift_into(q, eta, out.eta_dot, out.qd, out.sdeta); }) {
+      out.eta_dot.setZero(m);
+      c_.lift_into(q, eta, out.eta_dot, out.qd, out.sdeta);
+    } else {
+      out.qd = apply_S(c_, q, eta).template cast<T>();
+      out.sdeta = apply_Sdot(c_, q, out.qd, eta).template cast<T>();
+    }
+    if constexpr (requires { rne_.evaluate(q, out.qd, out.sdeta, out.v); }) {
+      out.v.resize(n);
+      rne_.evaluate(q, out.qd, out.sdeta, out.v);
+    } else {
+      out.v = rne_(q, out.qd, out.sdeta).template cast<T>();
+    }
+    if (friction_) out.v += (*friction_)(out.qd).template cast<T>();
+    if (Qx) out.v -= Qx->template cast<T>();
+    out.reduced_bias.resize(m);
+    out.pattern.St_times(out.S, out.v, out.reduced_bias);
+    // SᵀE τ (sdeta's storage holds E τ or S τ)
+    out.actuation.resize(m);
+    if constexpr (has_identity_StE<C>) {
+      out.actuation = tau.template cast<T>();
+    } else if constexpr (has_input_map<C, Q>) {
+      if constexpr (has_E_times_into<C, Q, TAU, vecN<T, N>>)
+        c_.E_times_into(q, tau, out.sdeta);
+      else
+        out.sdeta.noalias() = input_map(c_, q).template cast<T>() * tau.template cast<T>();
+      out.pattern.St_times(out.S, out.sdeta, out.actuation);
+    } else if constexpr (C::orthonormal_S) {
+      out.actuation = tau.template cast<T>();
+    } else {
+      out.sdeta.noalias() = out.S * tau.template cast<T>();
+      out.pattern.St_times(out.S, out.sdeta, out.actuation);
+    }
+    ldlt_factor_into(out.reduced_inertia, out.factor, "the reduced inertia M_η = SᵀMS");
+    out.eta_dot = out.actuation - out.reduced_bias;
+    out.factor.solve_in_place(out.eta_dot);
+    detail::check_overflow(out.eta_dot, "nh_forward_dynamics");
   }
 
   C c_;

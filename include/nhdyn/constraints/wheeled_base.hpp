@@ -416,6 +416,16 @@ class wheeled_base {
     return e;
   }
 
+  /// E τ into out (n entries) without forming E: τ at the actuated joints, zeros elsewhere.
+  template <class Q, class Tau, class Out>
+  void E_times_into(const Eigen::MatrixBase<Q>&, const Eigen::MatrixBase<Tau>& tau, Eigen::MatrixBase<Out>& out) const {
+    using T = typename Out::Scalar;
+    detail::check_size(tau, p(), "tau");
+    detail::check_size(out, n_, "E tau");
+    out.setZero();
+    for (int a = 0; a < p(); ++a) out(act_[std::size_t(a)]) = T(tau(a));
+  }
+
   /// q̇ = S(q) η without forming S.
   template <class Q, class Et>
   auto S_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Et>& eta) const {

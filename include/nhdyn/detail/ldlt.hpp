@@ -31,8 +31,14 @@ struct ldlt {
 
   template <class B>
   Eigen::Matrix<T, N, B::ColsAtCompileTime> solve(const Eigen::MatrixBase<B>& b) const {
-    const int n = static_cast<int>(L.rows());
     Eigen::Matrix<T, N, B::ColsAtCompileTime> x = b.template cast<T>();
+    solve_in_place(x);
+    return x;
+  }
+  /// x ← M⁻¹ x (each column), in x's storage: no allocation.
+  template <class X>
+  void solve_in_place(Eigen::MatrixBase<X>& x) const {
+    const int n = static_cast<int>(L.rows());
     for (int c = 0; c < x.cols(); ++c) {
       for (int i = 0; i < n; ++i)
         for (int j = 0; j < i; ++j) x(i, c) -= L(i, j) * x(j, c);
@@ -40,7 +46,6 @@ struct ldlt {
       for (int i = n - 1; i >= 0; --i)
         for (int j = i + 1; j < n; ++j) x(i, c) -= L(j, i) * x(j, c);
     }
-    return x;
   }
 };
 
@@ -65,11 +70,12 @@ double default_max_pivot_ratio() {
 /// and more, yet LDLᵀ without pivoting solves it to full accuracy when the scaled matrix is
 /// well conditioned (van der Sluis; Demmel, Applied Numerical Linear Algebra §2.4).
 /// pivot_ratio() keeps the unscaled ratio, a cheap lower bound of cond(M).
+/// `ldlt_factor_into(M, f)` factorises into f, whose storage is reused (no allocation when f.L
+/// is M's size already); `ldlt_factor(M)` returns a new factor.
 template <class T, int N>
-ldlt<T, N> ldlt_factor(const Eigen::Matrix<T, N, N>& M, const char* what = "matrix",
-                       double max_ratio = default_max_pivot_ratio<T>()) {
+void ldlt_factor_into(const Eigen::Matrix<T, N, N>& M, ldlt<T, N>& f, const char* what = "matrix",
+                      double max_ratio = default_max_pivot_ratio<T>()) {
   const int n = static_cast<int>(M.rows());
-  ldlt<T, N> f;
   f.L = M;
   double dmin = INFINITY, dmax = 0, smin = INFINITY;
   int jmin = 0;
@@ -102,6 +108,12 @@ ldlt<T, N> ldlt_factor(const Eigen::Matrix<T, N, N>& M, const char* what = "matr
        << "matrix's pivot ratio " << 1.0 / smin << " exceeds " << max_ratio << ")";
     throw numerical_error(os.str());
   }
+}
+template <class T, int N>
+ldlt<T, N> ldlt_factor(const Eigen::Matrix<T, N, N>& M, const char* what = "matrix",
+                       double max_ratio = default_max_pivot_ratio<T>()) {
+  ldlt<T, N> f;
+  ldlt_factor_into(M, f, what, max_ratio);
   return f;
 }
 
