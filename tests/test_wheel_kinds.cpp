@@ -43,6 +43,13 @@ io::robot_model load(const std::string& name) {
 }
 const wheeled_base<double>& base_of(const io::robot_model& r) { return std::get<wheeled_base<double>>(*r.constraint); }
 
+/// Every shipped robot file (examples/robots): each base constraint type and every wheeled_base.
+const char* const every_robot_file[] = {"paper5.json",                      "mobile_manipulator.json",
+                                        "mobile_manipulator_wheels.json",   "mobile_manipulator_bicycle.json",
+                                        "mobile_manipulator_castors.json",  "mecanum_arm.json",
+                                        "omni3_arm.json",                   "castor_drive_arm.json",
+                                        "powered_castors_arm.json",         "tiago_style.json"};
+
 const std::vector<std::string> shipped = {"mecanum_arm.json", "omni3_arm.json", "castor_drive_arm.json",
                                           "powered_castors_arm.json", "mobile_manipulator_castors.json"};
 
@@ -341,9 +348,7 @@ TEST_CASE("inverse_dynamics on a tree: evaluate into a reused tau = the composit
           "robot file's constraint, in double and in duals; its errors name tau, eta and eta_dot",
           "[wheel_kinds]") {
   std::mt19937 rng(2026);
-  for (const char* file : {"mobile_manipulator.json", "mobile_manipulator_wheels.json", "mobile_manipulator_bicycle.json",
-                           "mobile_manipulator_castors.json", "mecanum_arm.json", "omni3_arm.json",
-                           "castor_drive_arm.json", "powered_castors_arm.json", "tiago_style.json"}) {
+  for (const char* file : every_robot_file) {
     INFO(file);
     const auto r = load(file);
     std::visit(
@@ -392,9 +397,7 @@ TEST_CASE("nh_forward_dynamics on a tree: evaluate into one reused result = the 
           "[wheel_kinds]") {
   std::mt19937 rng(2027);
   nh_forward_dynamics_result<double> out;  // one result for every file: sizes change from file to file
-  for (const char* file : {"mobile_manipulator.json", "mobile_manipulator_wheels.json", "mobile_manipulator_bicycle.json",
-                           "mobile_manipulator_castors.json", "mecanum_arm.json", "omni3_arm.json",
-                           "castor_drive_arm.json", "powered_castors_arm.json", "tiago_style.json"}) {
+  for (const char* file : every_robot_file) {
     INFO(file);
     const auto r = load(file);
     std::visit(
