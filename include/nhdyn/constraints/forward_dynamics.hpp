@@ -21,7 +21,7 @@ enum class reduced_inertia_method { crba, rne_columns };
 
 /// What `nh_forward_dynamics_fn::evaluate` writes: η̇ and the quantities that form it, in
 /// storage the caller reuses from call to call (no allocation after the first call of a size,
-/// docs/api.md §6). T: the model's and the inputs' promoted scalar.
+/// docs/api.md §8). T: the model's and the inputs' promoted scalar.
 template <class T, int N = dynamic, int M = dynamic>
 struct nh_forward_dynamics_result {
   vecN<T, M> eta_dot;               ///< η̇ = M_η⁻¹ (SᵀE τ − h_η)
