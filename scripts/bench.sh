@@ -5,7 +5,8 @@
 #
 #   scripts/bench.sh                       # 9 repetitions in random interleaved order, medians
 #   NHDYN_BENCH_REPS=15 scripts/bench.sh   # more repetitions
-#   NHDYN_BENCH_FILTER='^rne/' scripts/bench.sh --no-docs   # a subset, JSON only
+#   NHDYN_BENCH_FILTER='^rne/' scripts/bench.sh --no-docs   # a subset, JSON only (build-bench/performance.json;
+#                                          # scripts/merge_bench.py merges it into docs/performance.json)
 #   NHDYN_BENCH_CLANG=1 scripts/bench.sh   # the two-compiler table's kernels built by clang++-14
 #                                          # (build-bench-clang/, docs/performance-clang.json);
 #                                          # the tables are then regenerated from both JSON files

@@ -119,7 +119,7 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
     if "partial_rerun" in ctx:  # some cases re-run later by a filtered run, merged by name
         pr = ctx["partial_rerun"]
         fams = sorted({"/".join(r.split("/")[:1]) for r in pr["run_names"]})
-        out[-1] = out[-1].rstrip("\n") + (f" The cases {', '.join(f'`{f}/…`' for f in fams)} of the robot files were "
+        out[-1] = out[-1].rstrip("\n") + (f" The cases {', '.join(f'`{f}/…`' for f in fams)} were "
                                          f"re-run {pr['date']} (a filtered run, the same binary and flags; "
                                          f"{len(pr['run_names'])} cases), and the ratios among them are of that run.\n")
 
@@ -276,6 +276,10 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
     out.append("")
 
     # ---------------------------------------------------------------- wheeled robots
+    def nh_allocs(m):  # the wheeled tables' last column: (nh, nh evaluate, fd, fd evaluate)
+        return ", ".join(al(allocs.get(f"{c}/{m}/{v}"))
+                         for c, v in (("nh_id", "rne"), ("nh_id", "evaluate"), ("nh_fd", "nhdyn"), ("nh_fd", "evaluate")))
+
     out.append("### A real robot's URDF with each constraint type (issue 14)\n")
     out.append("The shipped mobile manipulator (16 URDF joints on a planar base: n = 19) from its robot files: "
                "`nh_id/<robot>/{rne, lagrange}` (the paper's method; the projected Euler–Lagrange equations on "
@@ -295,8 +299,7 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
         worst_pair_ev = max(worst_pair_ev, pe or 0)
         least_el = min(least_el, ratio(el, nh) or 0)
         out.append(f"| {m} | {k} | {19 - k} | {ns(nh)} | {r2(pr)} | {ns(ev)} | {r2(pe)} | {ns(el)} | {ratio(el, nh):.0f} | {ns(fd)} | {ns(g(f'nh_fd/{m}/evaluate'))} | "
-                   f"{al(allocs.get(f'nh_id/{m}/rne'))}, {al(allocs.get(f'nh_id/{m}/evaluate'))}, {al(allocs.get(f'nh_fd/{m}/nhdyn'))}, "
-                   f"{al(allocs.get(f'nh_fd/{m}/evaluate'))} |")
+                   f"{nh_allocs(m)} |")
     out.append("")
     out.append(f"- Target nh ≤ {TARGET_NH}× the holonomic rne (paired): worst **{worst_pair:.2f}** — "
                f"{verdict(worst_pair)}; both into reused storage (`evaluate`): " +
@@ -325,8 +328,7 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
             worst_wpe = max(worst_wpe, pe or 0)
             least_wel = min(least_wel, ratio(el, nh) or 0)
         out.append(f"| {m} | {n_} | {k_} | {m_} | {p_} | {ns(nh)} | {r2(pr)} | {ns(ev)} | {r2(pe)} | {ns(el)} | {ratio(el, nh):.0f} | {ns(fd)} | {ns(g(f'nh_fd/{m}/evaluate'))} | "
-                   f"{r2(PAIRED.get(f'deriv_nh_pair/{m}'))} | {al(allocs.get(f'nh_id/{m}/rne'))}, {al(allocs.get(f'nh_id/{m}/evaluate'))}, "
-                   f"{al(allocs.get(f'nh_fd/{m}/nhdyn'))}, {al(allocs.get(f'nh_fd/{m}/evaluate'))} |")
+                   f"{r2(PAIRED.get(f'deriv_nh_pair/{m}'))} | {nh_allocs(m)} |")
     out.append("")
     out.append(f"- Target nh ≤ {TARGET_WHEEL_NH}× the holonomic rne (paired, redundancy resolution included): worst "
                f"**{worst_wp:.2f}** — {'met' if 0 < worst_wp <= TARGET_WHEEL_NH else 'NOT met'}; both into reused "
@@ -494,7 +496,7 @@ def two_compilers(med, second_med, second_compiler, first_compiler, rerun=frozen
         out.append(f"| {label} | {m} | {ns(a)} | {ns(b)} | {r2(r)} |")
     out.append("")
     if later:
-        out.append("\* re-run by g++ after the clang run (see the top of the page): the two medians are of different "
+        out.append("\\* re-run by g++ after the clang run (see the top of the page): the two medians are of different "
                    "runs, on a machine whose speed drifts from hour to hour, so no ratio is drawn from them.\n")
     out.append(f"- Target every kernel under clang within {TARGET_CLANG}× its g++ time: worst **{worst:.2f}** — "
                f"{'met' if 0 < worst <= TARGET_CLANG else 'NOT met'}.")

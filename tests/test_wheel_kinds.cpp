@@ -383,10 +383,10 @@ TEST_CASE("inverse_dynamics on a tree: evaluate into a reused tau = the composit
           }
           // errors: the caller's names
           VectorXd short_tau(p + 1), bad = eta;
-          CHECK_THROWS_WITH(id.evaluate(q, eta, eta_dot, short_tau), Catch::Matchers::Contains("tau"));
-          CHECK_THROWS_WITH(id.evaluate(q, VectorXd(eta.head(c.m() - 1)), eta_dot, tau), Catch::Matchers::Contains("eta"));
+          CHECK_THROWS_WITH(id.evaluate(q, eta, eta_dot, short_tau), Catch::Matchers::Contains("tau has"));
+          CHECK_THROWS_WITH(id.evaluate(q, VectorXd(eta.head(c.m() - 1)), eta_dot, tau), Catch::Matchers::Contains("eta has"));
           bad(0) = std::numeric_limits<double>::quiet_NaN();
-          CHECK_THROWS_WITH(id.evaluate(q, eta, bad, tau), Catch::Matchers::Contains("eta_dot"));
+          CHECK_THROWS_WITH(id.evaluate(q, eta, bad, tau), Catch::Matchers::Contains("eta_dot[0] is not finite"));
         },
         *r.constraint);
   }
@@ -397,6 +397,7 @@ TEST_CASE("nh_forward_dynamics on a tree: evaluate into one reused result = the 
           "[wheel_kinds]") {
   std::mt19937 rng(2027);
   nh_forward_dynamics_result<double> out;  // one result for every file: sizes change from file to file
+  nh_forward_dynamics_result<dual<double, 1>> dout;
   for (const char* file : every_robot_file) {
     INFO(file);
     const auto r = load(file);
@@ -427,24 +428,28 @@ TEST_CASE("nh_forward_dynamics on a tree: evaluate into one reused result = the 
             const VectorXd ref = Me.ldlt().solve(u - h);
             CHECK((out.eta_dot - ref).norm() <= 1e-9 * (1 + ref.norm()));
           }
-          // duals along τ: values and derivatives as the plain call's
+          // duals along τ_0, into a dual result reused across the files: values and derivatives
+          // as the plain call's, and ∂η̇/∂τ_0 = M_η⁻¹ SᵀE e_0 by Eigen's LDLT of the dense M_η
           using D = dual<double, 1>;
           const VectorXd q = random_q(n, rng), eta = random_vec(m, rng), tau = random_vec(p, rng, 3);
           vecN<D, dynamic> td(p);
           for (int j = 0; j < p; ++j) td(j) = D(tau(j), {j == 0 ? 1.0 : 0.0});
-          nh_forward_dynamics_result<D> dout;
           fd.evaluate(q, eta, td, dout);
           const vecN<D, dynamic> dc = fd(q, eta, td);
+          const MatrixXd S = c.S(q), E = input_map(c, q), M = mass_matrix(r.model)(q);
+          const VectorXd b0 = (S.transpose() * M * S).ldlt().solve(S.transpose() * E.col(0));
+          REQUIRE(dout.eta_dot.size() == m);
           for (int j = 0; j < m; ++j) {
             CHECK(dout.eta_dot(j).value() == dc(j).value());
             CHECK(dout.eta_dot(j).derivative(0) == dc(j).derivative(0));
+            CHECK(std::abs(dout.eta_dot(j).derivative(0) - b0(j)) <= 1e-9 * (1 + b0.norm()));
           }
           // errors: the caller's names
           VectorXd bad = eta;
           bad(0) = std::numeric_limits<double>::quiet_NaN();
-          CHECK_THROWS_WITH(fd.evaluate(q, eta, VectorXd(tau.head(p - 1)), out), Catch::Matchers::Contains("tau"));
-          CHECK_THROWS_WITH(fd.evaluate(q, bad, tau, out), Catch::Matchers::Contains("eta"));
-          CHECK_THROWS_WITH(fd.evaluate(VectorXd(q.head(n - 1)), eta, tau, out), Catch::Matchers::Contains("q"));
+          CHECK_THROWS_WITH(fd.evaluate(q, eta, VectorXd(tau.head(p - 1)), out), Catch::Matchers::StartsWith("tau has"));
+          CHECK_THROWS_WITH(fd.evaluate(q, bad, tau, out), Catch::Matchers::StartsWith("eta[0] is not finite"));
+          CHECK_THROWS_WITH(fd.evaluate(VectorXd(q.head(n - 1)), eta, tau, out), Catch::Matchers::StartsWith("q has"));
         },
         *r.constraint);
   }

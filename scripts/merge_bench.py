@@ -1,0 +1,41 @@
+#!/usr/bin/env python3
+"""Merges a filtered benchmark run into docs/performance.json, case by case.
+
+    NHDYN_BENCH_FILTER='^nh_(id|fd)/' scripts/bench.sh --no-docs        # writes build-bench/performance.json
+    scripts/merge_bench.py docs/performance.json build-bench/performance.json [--skip REGEX]
+    /usr/bin/python3 scripts/perf_table.py docs/performance.json docs/performance.md docs/performance_scaling.png ...
+
+Every case of the new run (its run_name) replaces the same case of the main file, or is added;
+--skip leaves the main file's cases whose run_name matches REGEX as they were (cases that the
+filter caught but whose tables divide them by cases it did not re-run). The main file's context
+records the re-run (`partial_rerun`: its date and case names), which perf_table.py states at
+the top of the page and uses to draw no ratio across runs where it must not (the clang table).
+"""
+import argparse
+import json
+import re
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("main")
+    ap.add_argument("new")
+    ap.add_argument("--skip", help="run_names (regex) to keep from the main file")
+    a = ap.parse_args()
+    with open(a.main) as f:
+        d = json.load(f)
+    with open(a.new) as f:
+        n = json.load(f)
+    new = [b for b in n["benchmarks"] if not (a.skip and re.search(a.skip, b["run_name"]))]
+    names = {b["run_name"] for b in new}
+    kept = [b for b in d["benchmarks"] if b.get("run_name") not in names]
+    print(f"merge_bench: {len(names)} cases from {a.new} ({len(d['benchmarks']) - len(kept)} entries replaced, "
+          f"{len(new)} written)")
+    d["benchmarks"] = kept + new
+    d["context"]["partial_rerun"] = {"date": n["context"]["date"], "run_names": sorted(names)}
+    with open(a.main, "w") as f:
+        json.dump(d, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
