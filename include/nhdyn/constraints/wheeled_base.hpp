@@ -499,11 +499,12 @@ class wheeled_base {
     detail::wheel_buffer<T, dynamic> b(kk), x(kk);
     Adot_qdot(f.X.data(), qd, b.data());
     f.solve(b.data(), x.data());
-    for (int c = 0; c < m(); ++c) qdd(eta_[std::size_t(c)]) = T(eta_dot(c));
+    const int mm = m(), mwi = mw();
+    for (int c = 0; c < mm; ++c) qdd(eta_[std::size_t(c)]) = T(eta_dot(c));
     for (int d = 0; d < kk; ++d) {
       T a = -x[d];
-      for (int i = 0; i < mw(); ++i) a += f.sd[d + i * kk] * T(eta_dot(Icol_[std::size_t(i)]));
-      qdd(W_[std::size_t(D_[std::size_t(d)])]) = a;
+      for (int i = 0; i < mwi; ++i) a += f.sd[d + i * kk] * T(eta_dot(Icol_[std::size_t(i)]));
+      qdd(Dq_[std::size_t(d)]) = a;
       if (!is_finite_scalar(a)) [[unlikely]]
         throw_not_solved(d, "accelerations");
     }
@@ -620,7 +621,7 @@ class wheeled_base {
   void copy_structure(const wheeled_base<U>& o) {
     n_ = o.n_, wheels_ = o.wheels_, names_ = o.names_, model_ = o.model_;
     rows_ = o.rows_, row_node_ = o.row_node_, paths_ = o.paths_, read_paths_ = o.read_paths_, spin_joint_ = o.spin_joint_;
-    W_ = o.W_, D_ = o.D_, I_ = o.I_, Icol_ = o.Icol_, dcol_ = o.dcol_, icol_ = o.icol_;
+    W_ = o.W_, D_ = o.D_, I_ = o.I_, Icol_ = o.Icol_, Dq_ = o.Dq_, dcol_ = o.dcol_, icol_ = o.icol_;
     eta_ = o.eta_, act_ = o.act_, weights_ = o.weights_, inv_weight_w_ = o.inv_weight_w_, act_eta_ = o.act_eta_, actw_ = o.actw_;
     depends_ = o.depends_, act_is_eta_ = o.act_is_eta_, mobility_ = o.mobility_, steerability_ = o.steerability_;
     Db_ = o.Db_, Db_pos_ = o.Db_pos_, kb_ = o.kb_;
@@ -642,7 +643,8 @@ class wheeled_base {
   // bias acceleration there. (The 3-D forms are the constructor's checks and reference_A.)
 
   /// A node's frame in the plane at q: the heading (c, s) = (cos Θ, sin Θ) and origin o; a
-  /// spin node's o is the wheel centre and a its spin axis's horizontal part.
+  /// spin node's o is the wheel centre and a its spin axis's horizontal part; a prismatic
+  /// node's a is its sliding axis (in the plane, at its parent's heading).
   template <class T>
   struct frame2 {
     T c, s;
@@ -655,7 +657,8 @@ class wheeled_base {
   /// The nodes' planar frames at q (Θ composed from each revolute joint's own sin/cos).
   template <class T, class Q>
   void frames(const Q& q, frame2<T>* X) const {
-    for (std::size_t i = 0; i < plane_.size(); ++i) {
+    const std::size_t nodes = plane_.size();
+    for (std::size_t i = 0; i < nodes; ++i) {
       const auto& nd = plane_[i];
       frame2<T> P{T(1), T(0), vec2<T>::Zero(), vec2<T>::Zero()};
       if (nd.parent >= 0) P = X[nd.parent];
@@ -672,7 +675,8 @@ class wheeled_base {
         x.o = P.o + P.turn(nd.D);
       } else {
         x.c = P.c, x.s = P.s;
-        x.o = P.o + P.turn(nd.D) + P.turn(nd.axis) * T(q(nd.joint));
+        x.a = P.turn(nd.axis);
+        x.o = P.o + P.turn(nd.D) + x.a * T(q(nd.joint));
       }
     }
   }
@@ -690,24 +694,25 @@ class wheeled_base {
     if (!X) X = own.data();
     frames(q, X);
     const int kk = k();
-    for (int i = 0; i < kk * nw(); ++i) aw[i] = T(0);
+    for (int i = 0, e = kk * nw(); i < e; ++i) aw[i] = T(0);
     for (int r = 0; r < kk;) {  // one wheel's rows at a time (they are consecutive)
       const int w = rows_[std::size_t(r)].wheel, sn = row_node_[std::size_t(r)];
       const frame2<T>& S = X[sn];
       const floor_frame<T> F(S.a, T(plane_[std::size_t(sn)].inv_len));
-      const vec2<T>& P = S.o;  // the contact point's (x, y): the centre's
-      const auto& path = all ? paths_[std::size_t(w)] : read_paths_[std::size_t(w)];
+      const vec2<T> P = S.o;  // the contact point's (x, y): the centre's
+      const auto& path_v = all ? paths_[std::size_t(w)] : read_paths_[std::size_t(w)];
+      const int* const path = path_v.data();
+      const int len = static_cast<int>(path_v.size());
+      const T rad = T(radius_[std::size_t(w)]);
       vec2<T> g[8];  // G's columns on the path (a longer path takes them one at a time)
-      const bool keep = path.size() <= 8;
+      const bool keep = len <= 8;
       if (keep)
-        for (std::size_t t = 0; t < path.size(); ++t) g[t] = column_of_G(X, path[t], P, T(radius_[std::size_t(w)]));
+        for (int t = 0; t < len; ++t) g[t] = column_of_G(X, path[t], P, rad);
       const T cg = T(cos_gamma_[std::size_t(w)]), sg = T(sin_gamma_[std::size_t(w)]);
       for (; r < kk && rows_[std::size_t(r)].wheel == w; ++r) {
         const vec2<T> u = F.row(rows_[std::size_t(r)].kind, cg, sg);
-        for (std::size_t t = 0; t < path.size(); ++t) {
-          const int j = path[t];
-          aw[r + j * kk] = u.dot(keep ? g[t] : column_of_G(X, j, P, T(radius_[std::size_t(w)])));
-        }
+        T* const row = aw + r;
+        for (int t = 0; t < len; ++t) row[path[t] * kk] = u.dot(keep ? g[t] : column_of_G(X, path[t], P, rad));
       }
     }
   }
@@ -716,8 +721,7 @@ class wheeled_base {
     const auto& nd = plane_[std::size_t(j)];
     if (nd.spin) return vec2<T>(-radius * X[j].a.y(), radius * X[j].a.x());  // −r a × e_z
     if (nd.revolute) return T(nd.sign) * perp(vec2<T>(P - X[j].o));
-    const frame2<T> Pf = nd.parent >= 0 ? X[nd.parent] : frame2<T>{T(1), T(0), vec2<T>::Zero(), vec2<T>::Zero()};
-    return Pf.turn(nd.axis);
+    return X[j].a;  // the sliding axis
   }
   /// A wheel's floor-plane directions from its spin axis's horizontal part a and ih = 1/|a|:
   /// f = a × e_z/|a| (a positive spin rolls it along f), ℓ = e_z × f = a/|a|; a row's unit
@@ -764,8 +768,7 @@ class wheeled_base {
       } else if (nd.revolute) {
         m.w += T(nd.sign) * qdi;
       } else {
-        const frame2<T> Pf = nd.parent >= 0 ? X[nd.parent] : frame2<T>{T(1), T(0), vec2<T>::Zero(), vec2<T>::Zero()};
-        const vec2<T> t = Pf.turn(nd.axis) * qdi;
+        const vec2<T> t = X[i].a * qdi;  // the sliding axis (frames)
         m.v += t;
         if (nd.parent >= 0) m.ac += T(2) * M[nd.parent].w * perp(t);
       }
@@ -912,13 +915,13 @@ class wheeled_base {
   template <class T, class Et, class QDo>
   void velocities(const T* sd, const Et& eta, QDo& qd) const {
     detail::check_size(eta, m(), "eta");
-    const int kk = k();
+    const int kk = k(), mm = m(), mwi = mw();
     using R = typename QDo::Scalar;
-    for (int c = 0; c < m(); ++c) qd(eta_[std::size_t(c)]) = R(eta(c));
+    for (int c = 0; c < mm; ++c) qd(eta_[std::size_t(c)]) = R(eta(c));
     for (int d = 0; d < kk; ++d) {
       R a(0);
-      for (int i = 0; i < mw(); ++i) a += R(sd[d + i * kk]) * R(eta(Icol_[std::size_t(i)]));
-      qd(W_[std::size_t(D_[std::size_t(d)])]) = a;
+      for (int i = 0; i < mwi; ++i) a += R(sd[d + i * kk]) * R(eta(Icol_[std::size_t(i)]));
+      qd(Dq_[std::size_t(d)]) = a;
     }
   }
   /// Sᵀ v into out (m entries): v at η's joints, plus S_Dᵀ v_D.
@@ -926,11 +929,11 @@ class wheeled_base {
   void project_force(const T* sd, const V& v, Out& out) const {
     detail::check_size(v, n_, "v");
     using R = typename Out::Scalar;
-    const int kk = k();
-    for (int c = 0; c < m(); ++c) out(c) = R(v(eta_[std::size_t(c)]));
-    for (int i = 0; i < mw(); ++i) {
+    const int kk = k(), mm = m(), mwi = mw();
+    for (int c = 0; c < mm; ++c) out(c) = R(v(eta_[std::size_t(c)]));
+    for (int i = 0; i < mwi; ++i) {
       R s(0);
-      for (int d = 0; d < kk; ++d) s += R(sd[d + i * kk]) * R(v(W_[std::size_t(D_[std::size_t(d)])]));
+      for (int d = 0; d < kk; ++d) s += R(sd[d + i * kk]) * R(v(Dq_[std::size_t(d)]));
       out(Icol_[std::size_t(i)]) += s;
     }
   }
@@ -955,29 +958,31 @@ class wheeled_base {
       for (const auto& aw : actw_) tau.row(aw.first).setZero();
       return;
     }
-    // B(i, a) = S(actuator a's joint, η's wheel-path entry i)
+    // B(i, a) = S(actuator a's joint, η's wheel-path entry i): a column of S_D, or a unit column
     const bool square = pw_ == mw_;
-    detail::wheel_buffer<U, dynamic> buf(2 * mw_ * pw_ + mw_ * mw_ + mw_);  // B, BW, G, x
-    U* const B = buf.data();
-    U* const BW = B + mw_ * pw_;
-    U* const G = BW + mw_ * pw_;
-    U* const x = G + mw_ * mw_;
+    detail::wheel_buffer<U, dynamic> buf(mw_ * pw_ + mw_ * mw_ + mw_);  // B, G, x
+    U* __restrict const B = buf.data();
+    U* __restrict const G = B + mw_ * pw_;
+    U* __restrict const x = G + mw_ * mw_;
     detail::wheel_buffer<int, dynamic> perm(mw_);
     for (int a = 0; a < pw_; ++a) {
       const int w = actw_[std::size_t(a)].second, d = dcol_[std::size_t(w)];
-      for (int i = 0; i < mw_; ++i) B[i + a * mw_] = d >= 0 ? U(sd[d + i * kk]) : U(icol_[std::size_t(w)] == i ? 1 : 0);
+      U* __restrict const b = B + a * mw_;
+      if (d >= 0) {
+        for (int i = 0; i < mw_; ++i) b[i] = U(sd[d + i * kk]);
+      } else {
+        for (int i = 0; i < mw_; ++i) b[i] = U(0);
+        b[icol_[std::size_t(w)]] = U(1);
+      }
     }
     if (square) {
       for (int i = 0; i < mw_ * mw_; ++i) G[i] = B[i];
-    } else {  // G = B W⁻¹ Bᵀ
-      for (int a = 0; a < pw_; ++a) {  // BW = B W⁻¹ in x's storage's place: B's columns scaled
-        const U iw = U(inv_weight_w_[std::size_t(a)]);
-        for (int i = 0; i < mw_; ++i) BW[i + a * mw_] = B[i + a * mw_] * iw;
-      }
-      for (int j = 0; j < mw_; ++j)  // each entry's sum in a register (not through memory)
+    } else {  // G = B W⁻¹ Bᵀ, each entry's sum in a register
+      const double* const iw = inv_weight_w_.data();
+      for (int j = 0; j < mw_; ++j)
         for (int i = j; i < mw_; ++i) {
           U g(0);
-          for (int a = 0; a < pw_; ++a) g += BW[i + a * mw_] * B[j + a * mw_];
+          for (int a = 0; a < pw_; ++a) g += (B[i + a * mw_] * U(iw[a])) * B[j + a * mw_];
           G[i + j * mw_] = g;
           G[j + i * mw_] = g;
         }
@@ -989,18 +994,15 @@ class wheeled_base {
       throw_uncontrollable(q, B);
     for (Eigen::Index c = 0; c < cols; ++c) {
       for (int i = 0; i < mw_; ++i) x[i] = U(r(Icol_[std::size_t(i)], c));
-      if (square)
+      if (square) {
         detail::lu_solve(G, perm.data(), mw_, x);
-      else
+        for (int a = 0; a < pw_; ++a) tau(actw_[std::size_t(a)].first, c) = x[a];
+      } else {  // τ_w = W⁻¹ Bᵀ x
         detail::ldlt_solve(G, mw_, x);
-      for (int a = 0; a < pw_; ++a) {
-        const int row = actw_[std::size_t(a)].first;
-        if (square) {
-          tau(row, c) = x[a];
-        } else {
+        for (int a = 0; a < pw_; ++a) {
           U t(0);
-          for (int i = 0; i < mw_; ++i) t += BW[i + a * mw_] * x[i];
-          tau(row, c) = t;
+          for (int i = 0; i < mw_; ++i) t += B[i + a * mw_] * x[i];
+          tau(actw_[std::size_t(a)].first, c) = t * U(inv_weight_w_[std::size_t(a)]);
         }
       }
     }
@@ -1109,6 +1111,7 @@ class wheeled_base {
   std::vector<int> W_{};                              ///< the wheels' paths' joints (q order)
   std::vector<int> D_{}, I_{};                        ///< W columns: dependent; in η
   std::vector<int> Icol_{};                           ///< per I_ entry: its η column
+  std::vector<int> Dq_{};                             ///< per D_ entry: its joint (q index), W_[D_[d]]
   std::vector<int> dcol_{}, icol_{};                  ///< per W column: its D position / I_ position, or −1
   std::vector<int> eta_{}, act_{};                    ///< q indices
   std::vector<double> weights_{};                     ///< per actuated joint
@@ -1465,6 +1468,7 @@ void wheeled_base<Sc>::build(const tree<Sc>& t, const wheeled_base_options& o) {
     } else {
       dcol_[std::size_t(i)] = static_cast<int>(D_.size());
       D_.push_back(i);
+      Dq_.push_back(j);
     }
   }
   // η must determine the motion at generic configurations (else it never does).
