@@ -98,7 +98,8 @@ class nh_forward_dynamics_fn : public stage_tag {
     return condition_number(reduced_inertia(q));  // which checks q
   }
 
-  /// h_η = Sᵀ rne(q, Sη, Ṡη).
+  /// h_η = Sᵀ rne(q, Sη, Ṡη): the forward dynamics' own h_η (without friction and applied
+  /// forces), by the same steps as evaluate, so the two agree bit for bit.
   template <class Q, class E>
   auto reduced_bias(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta) const {
     detail::check_size(q, c_.dof(), "q");
@@ -106,16 +107,12 @@ class nh_forward_dynamics_fn : public stage_tag {
     detail::check_finite(q, "q");
     detail::check_finite(eta, "eta");
     using T = promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>;
-    if constexpr (!has_Sdot_times<C, Q, vecN<T, N>, E> && requires(vecN<T, N>& v) { c_.lift_into(q, eta, eta, v, v); }) {
-      // (q̇, Ṡη) in one pass, the lift at η̇ = 0, where the constraint has no structured Ṡη
-      // (wheeled_base: its Ṡ would be S's dual derivative, a dense n × m matrix)
-      vecN<T, N> qd(c_.dof()), sdeta(c_.dof());
-      c_.lift_into(q, eta, vecN<T, M>::Zero(c_.m()), qd, sdeta);
-      return apply_St(c_, q, rne_(q, qd, sdeta));
-    } else {
-      const auto qd = apply_S(c_, q, eta);
-      return apply_St(c_, q, rne_(q, qd, apply_Sdot(c_, q, qd, eta)));
-    }
+    nh_forward_dynamics_result<T, N, M> r;
+    form_S(q, r);
+    bias_into(q, eta, r);
+    r.reduced_bias.resize(c_.m());
+    r.pattern.St_times(r.S, r.v, r.reduced_bias);
+    return std::move(r.reduced_bias);
   }
 
   /// η̇ = M_η⁻¹ (SᵀE τ − h_η), τ of the constraint's p actuators (m unless it says otherwise).
@@ -179,6 +176,42 @@ class nh_forward_dynamics_fn : public stage_tag {
     return std::move(out.eta_dot);
   }
 
+  /// S(q) into out.S (zeros, then the entries the constraint writes, or the constraint's S(q))
+  /// and its nonzero pattern.
+  template <class Q, class T>
+  void form_S(const Eigen::MatrixBase<Q>& q, nh_forward_dynamics_result<T, N, M>& out) const {
+    if constexpr (has_S_into<C, Q, matrix<T, N, M>>) {
+      out.S.setZero(c_.dof(), c_.m());
+      c_.S_into(q, out.S);
+    } else {
+      out.S = c_.S(q).template cast<T>();
+    }
+    out.pattern.scan(out.S);
+  }
+  /// q̇ = Sη and Ṡη into out.qd and out.sdeta, by one lift at η̇ = 0 into given storage where
+  /// the constraint has it (wheeled_base has no other Ṡη: its Ṡ would be S's dual derivative,
+  /// a dense n × m matrix); then v = rne(q, q̇, Ṡη) into out.v.
+  template <class Q, class E, class T>
+  void bias_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
+                 nh_forward_dynamics_result<T, N, M>& out) const {
+    const int n = c_.dof();
+    out.qd.resize(n);
+    out.sdeta.resize(n);
+    if constexpr (requires { c_.lift_into(q, eta, out.eta_dot, out.qd, out.sdeta); }) {
+      out.eta_dot.setZero(c_.m());
+      c_.lift_into(q, eta, out.eta_dot, out.qd, out.sdeta);
+    } else {
+      out.qd = apply_S(c_, q, eta).template cast<T>();
+      out.sdeta = apply_Sdot(c_, q, out.qd, eta).template cast<T>();
+    }
+    if constexpr (requires { rne_.evaluate(q, out.qd, out.sdeta, out.v); }) {
+      out.v.resize(n);
+      rne_.evaluate(q, out.qd, out.sdeta, out.v);
+    } else {
+      out.v = rne_(q, out.qd, out.sdeta).template cast<T>();
+    }
+  }
+
   /// The forward dynamics into out: S(q); M(q) (CRBA) and M_η = SᵀMS over S's nonzeros;
   /// h_η = Sᵀ(rne(q, Sη, Ṡη) + τ_f − Q_ext) with (q̇, Ṡη) from one lift at η̇ = 0; SᵀEτ; then
   /// LDLᵀ of M_η and the solve, each into out's storage.
@@ -195,15 +228,7 @@ class nh_forward_dynamics_fn : public stage_tag {
     detail::check_finite(eta, "eta");
     detail::check_finite(tau, "tau");
     const int n = c_.dof(), m = c_.m();
-    using SMat = matrix<T, N, M>;
-    // S(q): zeros, then the entries the constraint writes (S_into), or the constraint's S(q)
-    if constexpr (has_S_into<C, Q, SMat>) {
-      out.S.setZero(n, m);
-      c_.S_into(q, out.S);
-    } else {
-      out.S = c_.S(q).template cast<T>();
-    }
-    out.pattern.scan(out.S);
+    form_S(q, out);
     // M(q) and M_η = SᵀMS
     out.reduced_inertia.resize(m, m);
     if (method_ == reduced_inertia_method::crba) {
@@ -220,24 +245,7 @@ class nh_forward_dynamics_fn : public stage_tag {
     } else {
       out.reduced_inertia = reduced_inertia(q).template cast<T>();
     }
-    // q̇ and Ṡη: one lift at η̇ = 0 into given storage where the constraint has it (wheeled_base
-    // has no other Ṡη: its Ṡ would be S's dual derivative, a dense n × m matrix); then
-    // v = rne(q, q̇, Ṡη) (+ τ_f − Q_ext)
-    out.qd.resize(n);
-    out.sdeta.resize(n);
-    if constexpr (requires { c_.lift_into(q, eta, out.eta_dot, out.qd, out.sdeta); }) {
-      out.eta_dot.setZero(m);
-      c_.lift_into(q, eta, out.eta_dot, out.qd, out.sdeta);
-    } else {
-      out.qd = apply_S(c_, q, eta).template cast<T>();
-      out.sdeta = apply_Sdot(c_, q, out.qd, eta).template cast<T>();
-    }
-    if constexpr (requires { rne_.evaluate(q, out.qd, out.sdeta, out.v); }) {
-      out.v.resize(n);
-      rne_.evaluate(q, out.qd, out.sdeta, out.v);
-    } else {
-      out.v = rne_(q, out.qd, out.sdeta).template cast<T>();
-    }
+    bias_into(q, eta, out);
     if (friction_) out.v += (*friction_)(out.qd).template cast<T>();
     if (Qx) out.v -= Qx->template cast<T>();
     out.reduced_bias.resize(m);
