@@ -343,9 +343,7 @@ template <class S, class C, class Out>
 auto nh_tree_pipeline(const tree<S>& t, const C& c, rne_options o, Out out) {
   return nh_pipeline_with(t, c, rne(t, o), std::move(out));
 }
-}  // namespace detail
 
-namespace detail {
 /// inverse_dynamics on a tree (constraint run-time sized): the composition project ∘ rne ∘
 /// lift itself (it derives from it: every call form it has, the same numbers), and
 /// `evaluate(q, η, η̇, τ)`, the same three stages into storage: lift.into writes ξ's q̇ and q̈
