@@ -19,7 +19,7 @@ if(TARGET nhdyn_tool)
     target_compile_definitions(${name} PRIVATE NHDYN_TOOL_PATH="$<TARGET_FILE:nhdyn_tool>"
                                                 "NHDYN_SOURCE_DIR=\"${PROJECT_SOURCE_DIR}\"")
     if(TARGET nhdyn::urdf)
-      target_link_libraries(${name} PRIVATE nhdyn::urdf)
+      nhdyn_link_loaders(${name})
     endif()
     add_dependencies(${name} nhdyn_tool)
     add_test(NAME ${name} COMMAND ${name} --use-colour no)

@@ -5,7 +5,8 @@ find_program(NHDYN_CHROMIUM NAMES chromium chromium-browser)
 if(TARGET nhdyn_tool AND TARGET nhdyn::urdf AND NHDYN_HAVE_VIEWER AND NHDYN_CHROMIUM
    AND EXISTS ${PROJECT_SOURCE_DIR}/viewer/node_modules/puppeteer-core/package.json)
   nhdyn_add_test(tool_test_view ${CMAKE_CURRENT_SOURCE_DIR}/viewer/test_view.cpp)
-  target_link_libraries(tool_test_view PRIVATE nhdyn::urdf nlohmann_json::nlohmann_json)
+  target_link_libraries(tool_test_view PRIVATE nlohmann_json::nlohmann_json)
+  nhdyn_link_loaders(tool_test_view)
   target_compile_definitions(tool_test_view PRIVATE NHDYN_TOOL_PATH="$<TARGET_FILE:nhdyn_tool>"
                                                     NHDYN_NODE="${NHDYN_NODE}" NHDYN_CHROMIUM="${NHDYN_CHROMIUM}")
   add_dependencies(tool_test_view nhdyn_tool)

@@ -8,7 +8,7 @@ import re
 import sys
 
 LAYERS = [
-    ["errors.hpp", "version.hpp"],  # files at the top of include/nhdyn/
+    ["config.hpp", "errors.hpp", "version.hpp"],  # files at the top of include/nhdyn/
     ["scalar"],        # number types and their traits
     ["detail"],        # small buffers, factorisations: no model knowledge
     ["model"],         # chains, trees, their validated constants (DH and tree kernels' data)

@@ -72,3 +72,9 @@ step("configure the consumer"
 step("build the consumer (one translation unit per installed header, and the program)"
      "${CMAKE_COMMAND}" --build "${build}" -j 2)
 step("run the consumer" "${build}/nhdyn_consumer")
+if(EXISTS "${build}/nhdyn_consumer_compiled")
+  step("run the consumer of nhdyn::compiled"
+       "${build}/nhdyn_consumer_compiled" "${prefix}/share/nhdyn/robots/mobile_manipulator_wheels.json")
+elseif(EXISTS "${prefix}/lib/libnhdyn_compiled.a" OR EXISTS "${prefix}/lib64/libnhdyn_compiled.a")
+  message(FATAL_ERROR "install test: libnhdyn_compiled.a is installed but the consumer found no nhdyn::compiled")
+endif()

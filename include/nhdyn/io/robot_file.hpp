@@ -37,6 +37,7 @@
 #include <variant>
 #include <vector>
 
+#include "../config.hpp"
 #include "../constraints/constraint.hpp"
 #include "../model/lock.hpp"
 #include "json.hpp"
@@ -79,6 +80,31 @@ struct robot_model {
   }
 };
 
+/// The robot r with the joints that `locks` names or globs held at the given positions
+/// (model/lock.hpp's lock on its tree); its constraint is read again on the smaller tree. A
+/// joint the constraint involves (the planar base's, a wheel's, a castor's) cannot be
+/// locked: model_error naming it and the constraint. `where` begins every message.
+NHDYN_COMPILED_INLINE robot_model lock_robot(robot_model r, const std::vector<std::pair<std::string, double>>& locks,
+                                             const std::string& where);
+/// A JSON model (a DH chain, its optional differential_drive, its "locked" joints) as a
+/// robot: the chain as a tree (as_tree: joints joint1…, bodies link1…, the base `base`), the
+/// constraint on it with the same joint indices, and the locked joints held (lock_robot:
+/// a joint of the constraint cannot be). A DH chain with joints held is no longer a DH chain;
+/// this is how the tool, scenes and Python load a model file with "locked". `where` begins
+/// the messages about the locked joints.
+NHDYN_COMPILED_INLINE robot_model as_robot(const model<double>& m, const std::string& where = "locked: ");
+/// The robot file's text; `path` locates the URDF (relative paths from its folder) and names
+/// the file in messages.
+NHDYN_COMPILED_INLINE robot_model parse_robot_file(const std::string& text, const std::string& path, urdf_options opt = {});
+/// r's constraint read again on the tree t (r's joints, other placements: a plant whose link
+/// lengths differ from the file's), so that the geometry a constraint takes from the URDF
+/// (the wheels' positions) follows t. Warnings were given when r was loaded: none again.
+/// Empty when r has no constraint.
+NHDYN_COMPILED_INLINE std::optional<robot_constraint> constraint_on(const robot_model& r, const tree<double>& t);
+/// The robot file at `path`.
+NHDYN_COMPILED_INLINE robot_model load_robot_file(const std::string& path, urdf_options opt = {});
+
+#if NHDYN_DEFINES(NHDYN_PART_IO)
 namespace detail {
 /// Index (q order) of the joint named by field `f` of a constraint object; errors list the
 /// movable joints.
@@ -326,12 +352,8 @@ std::vector<bool> constraint_joints(const C& c, int n) {
 
 }  // namespace detail
 
-/// The robot r with the joints that `locks` names or globs held at the given positions
-/// (model/lock.hpp's lock on its tree); its constraint is read again on the smaller tree. A
-/// joint the constraint involves (the planar base's, a wheel's, a castor's) cannot be
-/// locked: model_error naming it and the constraint. `where` begins every message.
-inline robot_model lock_robot(robot_model r, const std::vector<std::pair<std::string, double>>& locks,
-                              const std::string& where) {
+NHDYN_COMPILED_INLINE robot_model lock_robot(robot_model r, const std::vector<std::pair<std::string, double>>& locks,
+                                             const std::string& where) {
   if (locks.empty()) return r;
   lock_map m;
   try {
@@ -373,22 +395,14 @@ inline robot_model lock_robot(robot_model r, const std::vector<std::pair<std::st
   return r;
 }
 
-/// A JSON model (a DH chain, its optional differential_drive, its "locked" joints) as a
-/// robot: the chain as a tree (as_tree: joints joint1…, bodies link1…, the base `base`), the
-/// constraint on it with the same joint indices, and the locked joints held (lock_robot:
-/// a joint of the constraint cannot be). A DH chain with joints held is no longer a DH chain;
-/// this is how the tool, scenes and Python load a model file with "locked". `where` begins
-/// the messages about the locked joints.
-inline robot_model as_robot(const model<double>& m, const std::string& where = "locked: ") {
+NHDYN_COMPILED_INLINE robot_model as_robot(const model<double>& m, const std::string& where) {
   robot_model r{.model = as_tree(m.chain), .constraint = std::nullopt, .name = m.chain.name(),
                 .constraint_source = {}, .path = {}, .planar_base = false, .locked = {}};
   if (m.constraint) r.constraint = *m.constraint;
   return lock_robot(std::move(r), m.locked, where);
 }
 
-/// The robot file's text; `path` locates the URDF (relative paths from its folder) and names
-/// the file in messages.
-inline robot_model parse_robot_file(const std::string& text, const std::string& path, urdf_options opt = {}) {
+NHDYN_COMPILED_INLINE robot_model parse_robot_file(const std::string& text, const std::string& path, urdf_options opt) {
   const std::string where = "robot file '" + path + "': ";
   const json j = parse_strict(text, where);
   if (!j.is_object()) throw model_error(where + "expected a JSON object, got " + detail::describe(j));
@@ -422,11 +436,7 @@ inline robot_model parse_robot_file(const std::string& text, const std::string& 
   return out;
 }
 
-/// r's constraint read again on the tree t (r's joints, other placements: a plant whose link
-/// lengths differ from the file's), so that the geometry a constraint takes from the URDF
-/// (the wheels' positions) follows t. Warnings were given when r was loaded: none again.
-/// Empty when r has no constraint.
-inline std::optional<robot_constraint> constraint_on(const robot_model& r, const tree<double>& t) {
+NHDYN_COMPILED_INLINE std::optional<robot_constraint> constraint_on(const robot_model& r, const tree<double>& t) {
   if (r.constraint_source.is_null()) return r.constraint;
   urdf_options opt;
   opt.planar_base = r.planar_base;
@@ -434,13 +444,14 @@ inline std::optional<robot_constraint> constraint_on(const robot_model& r, const
   return detail::read_robot_constraint(r.constraint_source, t, detail::place{"robot file '" + r.path + "'"}, opt);
 }
 
-/// The robot file at `path`.
-inline robot_model load_robot_file(const std::string& path, urdf_options opt = {}) {
+NHDYN_COMPILED_INLINE robot_model load_robot_file(const std::string& path, urdf_options opt) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw model_error("robot file '" + path + "': cannot open the file");
   std::ostringstream ss;
   ss << in.rdbuf();
   return parse_robot_file(ss.str(), path, std::move(opt));
 }
+
+#endif  // NHDYN_DEFINES(NHDYN_PART_IO)
 
 }  // namespace nhdyn::io

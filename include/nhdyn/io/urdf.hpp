@@ -18,11 +18,8 @@
 ///   (not positive semi-definite, or principal moments breaking the triangle inequality) is
 ///   used as written with one warning per link, or refused with `urdf_options::strict`.
 /// - Gravity: (0, 0, −9.81) unless the options say otherwise.
-#include <tinyxml2.h>
-
 #include <Eigen/Geometry>
 #include <cmath>
-#include <console_bridge/console.h>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -30,11 +27,20 @@
 #include <mutex>
 #include <sstream>
 #include <string>
-#include <urdf_parser/urdf_parser.h>
 #include <vector>
 
+#include "../config.hpp"
+#include "../detail/compiled_abi.hpp"
 #include "../errors.hpp"
 #include "../model/tree.hpp"
+
+#if NHDYN_DEFINES(NHDYN_PART_IO)  // the parsers' headers: only where the loaders are defined
+#include <tinyxml2.h>
+
+#include <console_bridge/console.h>
+#include <urdf_parser/urdf_parser.h>
+#endif
+
 
 namespace nhdyn::io {
 
@@ -57,6 +63,12 @@ struct urdf_options {
   bool planar_base = false;
 };
 
+/// A URDF document (its text) as a tree. `where` names it in messages (a file name).
+NHDYN_COMPILED_INLINE tree<double> parse_urdf(const std::string& text, const std::string& where = "URDF", urdf_options opt = {});
+/// The URDF file at `path` as a tree.
+NHDYN_COMPILED_INLINE tree<double> load_urdf(const std::string& path, urdf_options opt = {});
+
+#if NHDYN_DEFINES(NHDYN_PART_IO)
 namespace detail {
 
 /// Collects what urdfdom says through console_bridge while it parses (instead of printing it).
@@ -150,8 +162,7 @@ inline std::string joint_cycle(const urdf_document& doc) {
 
 }  // namespace detail
 
-/// A URDF document (its text) as a tree. `where` names it in messages (a file name).
-inline tree<double> parse_urdf(const std::string& text, const std::string& where = "URDF", urdf_options opt = {}) {
+NHDYN_COMPILED_INLINE tree<double> parse_urdf(const std::string& text, const std::string& where, urdf_options opt) {
   const std::string at = where + ": ";
   const detail::urdf_document doc = detail::read_document(text, at);
   if (const std::string cycle = detail::joint_cycle(doc); !cycle.empty())
@@ -346,12 +357,14 @@ inline tree<double> parse_urdf(const std::string& text, const std::string& where
 }
 
 /// The URDF file at `path` as a tree; messages name the file.
-inline tree<double> load_urdf(const std::string& path, urdf_options opt = {}) {
+NHDYN_COMPILED_INLINE tree<double> load_urdf(const std::string& path, urdf_options opt) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw model_error(path + ": cannot open the file");
   std::ostringstream ss;
   ss << in.rdbuf();
   return parse_urdf(ss.str(), path, std::move(opt));
 }
+
+#endif  // NHDYN_DEFINES(NHDYN_PART_IO)
 
 }  // namespace nhdyn::io

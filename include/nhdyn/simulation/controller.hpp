@@ -32,6 +32,8 @@
 
 #include <Eigen/Dense>
 
+#include "../config.hpp"
+#include "../detail/compiled_abi.hpp"
 #include "../constraints/stages.hpp"
 #include "../detail/ldlt.hpp"
 #include "../dynamics/friction.hpp"
@@ -59,7 +61,9 @@ struct rac_gains {
 /// P with A_cᵀP + PA_c = −I₆, A_c = [0 I; −K₀ −K₁], by the vectorised (Kronecker) linear
 /// system (I ⊗ A_cᵀ + A_cᵀ ⊗ I) vec P = −vec I. Throws numerical_error if A_c is not
 /// Hurwitz (P not positive definite).
-inline Eigen::Matrix<double, 6, 6> lyapunov_P(const Eigen::Matrix3d& K0, const Eigen::Matrix3d& K1) {
+NHDYN_COMPILED_INLINE Eigen::Matrix<double, 6, 6> lyapunov_P(const Eigen::Matrix3d& K0, const Eigen::Matrix3d& K1);
+#if NHDYN_DEFINES(NHDYN_PART_SIMULATION)
+NHDYN_COMPILED_INLINE Eigen::Matrix<double, 6, 6> lyapunov_P(const Eigen::Matrix3d& K0, const Eigen::Matrix3d& K1) {
   using M6 = Eigen::Matrix<double, 6, 6>;
   M6 Ac = M6::Zero();
   Ac.topRightCorner<3, 3>().setIdentity();
@@ -75,10 +79,12 @@ inline Eigen::Matrix<double, 6, 6> lyapunov_P(const Eigen::Matrix3d& K0, const E
       L.fullPivLu().solve(Eigen::Map<const Eigen::Matrix<double, 36, 1>>(minusI.data()));
   M6 P = Eigen::Map<const M6>(p.data());
   P = (0.5 * (P + P.transpose())).eval();
-  if (Eigen::SelfAdjointEigenSolver<M6>(P).eigenvalues().minCoeff() <= 0 || !P.allFinite())
+  // positive definite ⇔ its Cholesky factor exists (LLT: far less to compile than an eigensolver)
+  if (!P.allFinite() || Eigen::LLT<M6>(P).info() != Eigen::Success)
     throw numerical_error("controller gains: A_c = [0 I; −K₀ −K₁] is not Hurwitz (no positive-definite P)");
   return P;
 }
+#endif  // NHDYN_DEFINES(NHDYN_PART_SIMULATION)
 
 namespace detail {
 template <class S, int N>

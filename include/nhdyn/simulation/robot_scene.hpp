@@ -25,6 +25,8 @@
 #include <string>
 #include <variant>
 
+#include "../config.hpp"
+#include "../detail/compiled_abi.hpp"
 #include "../constraints/holonomic.hpp"
 #include "../io/robot_file.hpp"
 #include "simulation.hpp"
@@ -248,14 +250,20 @@ struct scene_controller {
 /// as a tree) by simulate_scene_with and the scene's controller. Throws
 /// for a scene that cannot be set up (unknown frame or joint, wrong sizes, a controller that
 /// does not fit its reference). A function object, as `simulate`: the closed loops (one per
-/// constraint type) are compiled only where it is called.
+/// constraint type) are compiled only where it is called, or once in nhdyn::compiled
+/// (config.hpp), which a program linking it calls instead.
 struct simulate_scene_fn {
   template <std::same_as<run_spec> Spec>
-  run_result operator()(const Spec& s) const {
-    if (s.robot == "paper5" && s.plant_terms == terms{} && s.model_terms == terms{}) return simulate(s);
-    return simulate_scene_with(s, scene_controller{s});
-  }
+  run_result operator()(const Spec& s) const;
 };
+template <std::same_as<run_spec> Spec>
+run_result simulate_scene_fn::operator()(const Spec& s) const {  // not inline: extern template below
+  if (s.robot == "paper5" && s.plant_terms == terms{} && s.model_terms == terms{}) return simulate(s);
+  return simulate_scene_with(s, scene_controller{s});
+}
+#if !NHDYN_DEFINES(NHDYN_PART_SIMULATION)
+extern template run_result simulate_scene_fn::operator()<run_spec>(const run_spec&) const;
+#endif
 inline constexpr simulate_scene_fn simulate_scene{};
 
 }  // namespace nhdyn

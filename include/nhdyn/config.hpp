@@ -1,0 +1,37 @@
+#pragma once
+/// \file config.hpp
+/// Header-only or compiled (issue 33 item 4). nhdyn is header-only; the optional library
+/// `nhdyn::compiled` (CMake target, built by default when urdfdom is found) holds the
+/// definitions of the file loaders (io/urdf.hpp, io/robot_file.hpp) compiled once, so that a
+/// program that links it does not compile them again in every file that includes them.
+///
+/// - Header-only (nothing defined): every function is defined in its header, `inline`.
+/// - `NHDYN_COMPILED` (set by linking `nhdyn::compiled`): the headers declare the compiled
+///   functions and leave out their definitions (and the urdfdom and tinyxml2 headers they
+///   need); the program links them from the library.
+/// - `NHDYN_COMPILED_SOURCE` = a part (the library's own sources, src/compiled/, one per
+///   part): the headers define that part's compiled functions once, not inline, and declare
+///   the other parts'.
+///
+/// The same definitions are compiled either way, from the same headers: a program gives the
+/// same numbers bit for bit header-only or compiled (tests/compiled/).
+
+/// The parts of nhdyn::compiled, one source file each (src/compiled/).
+#define NHDYN_PART_IO 1          ///< io/urdf.hpp, io/robot_file.hpp (src/compiled/io.cpp)
+#define NHDYN_PART_SIMULATION 2  ///< simulation/robot_scene.hpp, controller.hpp (simulation.cpp)
+
+/// NHDYN_DEFINES(part): whether this translation unit defines the part's compiled functions.
+#if defined(NHDYN_COMPILED_SOURCE)
+/// The library's source file of part NHDYN_COMPILED_SOURCE: that part's definitions, external;
+/// the other parts declared only (another source file defines them).
+#define NHDYN_DEFINES(part) (NHDYN_COMPILED_SOURCE == (part))
+#define NHDYN_COMPILED_INLINE
+#elif defined(NHDYN_COMPILED)
+/// A program linking nhdyn::compiled: the compiled functions are declared only.
+#define NHDYN_DEFINES(part) 0
+#define NHDYN_COMPILED_INLINE
+#else
+/// Header-only: the compiled functions are defined here, inline.
+#define NHDYN_DEFINES(part) 1
+#define NHDYN_COMPILED_INLINE inline
+#endif
