@@ -41,7 +41,6 @@
 #include <urdf_parser/urdf_parser.h>
 #endif
 
-
 namespace nhdyn::io {
 
 struct urdf_options {
