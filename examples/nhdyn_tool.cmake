@@ -14,11 +14,7 @@ target_link_libraries(nhdyn_tool_objects PUBLIC nhdyn::json nhdyn::boost CLI11::
                                          PRIVATE nhdyn_project_options nhdyn_program_options)
 target_include_directories(nhdyn_tool_objects PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/nhdyn_tool)
 if(TARGET nhdyn::urdf)  # --model x.urdf
-  if(TARGET nhdyn_compiled)  # the loaders compiled once (include/nhdyn/config.hpp)
-    target_link_libraries(nhdyn_tool_objects PUBLIC nhdyn::compiled)
-  else()
-    target_link_libraries(nhdyn_tool_objects PUBLIC nhdyn::urdf)
-  endif()
+  nhdyn_link_loaders(nhdyn_tool_objects PUBLIC)  # nhdyn::compiled where it is built
   target_compile_definitions(nhdyn_tool_objects PRIVATE NHDYN_TOOL_URDF=1)
 endif()
 # `mpirun -n N nhdyn simulate …` (Debian's libopenmpi-dev, openmpi-bin): runs spread over

@@ -1,9 +1,10 @@
 #pragma once
 /// \file config.hpp
 /// Header-only or compiled (issue 33 item 4). nhdyn is header-only; the optional library
-/// `nhdyn::compiled` (CMake target, built by default when urdfdom is found) holds the
-/// definitions of the file loaders (io/urdf.hpp, io/robot_file.hpp) compiled once, so that a
-/// program that links it does not compile them again in every file that includes them.
+/// `nhdyn::compiled` (CMake target, built by default when urdfdom, tinyxml2, nlohmann_json and
+/// Boost are found) holds the file loaders (io/urdf.hpp, io/robot_file.hpp), `simulate_scene`
+/// and `lyapunov_P` (simulation/) compiled once, so that a program that links it does not
+/// compile them again in every file that includes them (docs/install.md lists them).
 ///
 /// - Header-only (nothing defined): every function is defined in its header, `inline`.
 /// - `NHDYN_COMPILED` (set by linking `nhdyn::compiled`): the headers declare the compiled

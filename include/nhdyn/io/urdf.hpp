@@ -64,7 +64,7 @@ struct urdf_options {
 
 /// A URDF document (its text) as a tree. `where` names it in messages (a file name).
 NHDYN_COMPILED_INLINE tree<double> parse_urdf(const std::string& text, const std::string& where = "URDF", urdf_options opt = {});
-/// The URDF file at `path` as a tree.
+/// The URDF file at `path` as a tree; messages name the file.
 NHDYN_COMPILED_INLINE tree<double> load_urdf(const std::string& path, urdf_options opt = {});
 
 #if NHDYN_DEFINES(NHDYN_PART_IO)
@@ -355,7 +355,6 @@ NHDYN_COMPILED_INLINE tree<double> parse_urdf(const std::string& text, const std
                       std::move(frames));
 }
 
-/// The URDF file at `path` as a tree; messages name the file.
 NHDYN_COMPILED_INLINE tree<double> load_urdf(const std::string& path, urdf_options opt) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw model_error(path + ": cannot open the file");
