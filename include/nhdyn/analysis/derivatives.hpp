@@ -34,6 +34,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <tuple>
 #include <vector>
 
 #include "../constraints/constraint.hpp"
@@ -210,6 +211,20 @@ struct st_plan {
     if (i < len) Eigen::Map<V>(to + len - 4) = Eigen::Map<const V>(from + len - 4);
   }
 };
+/// One dual pass's vectors of K lanes: x = q + Σ ε_k e_j, its lift (xd, xdd), v in duals and
+/// the projection Pv (run-time sized; a result's scratch keeps them between calls).
+template <class T, int K>
+struct dual_lanes {
+  vecN<dual<T, K>, Eigen::Dynamic> x, xd, xdd, v, pv;
+};
+/// `kept` when N is run-time (its storage reused from call to call), else `local` (on the stack).
+template <int N, class Kept, class Local>
+auto& run_time_or_local(Kept& kept, Local& local) {
+  if constexpr (N == Eigen::Dynamic)
+    return kept;
+  else
+    return local;
+}
 }  // namespace detail
 
 /// τ and ∂τ/∂(q, η, η̇) of the nonholonomic inverse dynamics, and ∂q̇/∂q of the lift
@@ -239,6 +254,13 @@ struct nh_derivatives_result {
     detail::object_tag se_owner;  ///< the function object (or a copy) whose constraint wrote se
     Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> jd;
     Eigen::Matrix<T, M, Eigen::Dynamic> w, z, stx;
+    Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> solved;  ///< (SᵀE)⁺ stx (p rows)
+    /// The inputs in T, the lifted (q̇, q̈), q + ε q̇ and the dual passes' vectors (K = 1, 2, 4
+    /// lanes): kept for a run-time-sized constraint (compile-time sizes live on the stack).
+    vecN<T, Eigen::Dynamic> q, qd, qdd;
+    vecN<T, M> eta, eta_dot;
+    vecN<dual<T, 1>, Eigen::Dynamic> q_eps;
+    std::tuple<detail::dual_lanes<T, 1>, detail::dual_lanes<T, 2>, detail::dual_lanes<T, 4>> lanes;
   } work;
 };
 
@@ -250,7 +272,7 @@ struct nh_derivatives_result {
 template <class S, class C>
 class inverse_dynamics_derivatives_fn {
  public:
-  inverse_dynamics_derivatives_fn(const tree<S>& t, const C& c, rne_options o = {}) : d_(t, o), c_(c) {
+  inverse_dynamics_derivatives_fn(const tree<S>& t, const C& c, rne_options o = {}) : d_(t, o), c_(c), project_(c) {
     if (c.dof() != t.dof())
       throw input_error("inverse_dynamics_derivatives: the constraint is for " + std::to_string(c.dof()) +
                         " joints, model '" + t.name() + "' has " + std::to_string(t.dof()));
@@ -283,9 +305,10 @@ class inverse_dynamics_derivatives_fn {
     return out;
   }
   /// Into a result whose storage (matrices and scratch) is reused from call to call, for
-  /// inputs in the model's scalar; the small vectors of the lift and the constraint's dual
-  /// pass are still allocated. `out` must not alias the inputs; after an exception its
-  /// contents are unspecified.
+  /// inputs in the model's scalar: no heap allocation once `out` has its sizes, where the
+  /// constraint lifts and projects into given storage (every built-in base constraint; a
+  /// user constraint's own S products may allocate). `out` must not alias the inputs; after
+  /// an exception its contents are unspecified.
   template <class Q, class E, class ED>
     requires detail::in_scalar<S, Q, E, ED>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
@@ -312,14 +335,31 @@ class inverse_dynamics_derivatives_fn {
     constexpr int N = C::n_at_compile_time;
     detail::check_reduced_state(c_, q_in, eta_in, eta_dot_in);
     const int n = c_.dof(), m = c_.m();
-    const vecN<T, N> q = q_in.template cast<T>();
-    const vecN<T, M> eta = eta_in.template cast<T>(), eta_dot = eta_dot_in.template cast<T>();
     auto& w = out.work;
-    // q̇ = Sη; S and Ṡ at once: S depends on q_D alone, so Ṡ(q, q̇) = Σ_{j∈D} ∂S/∂q_j q̇_j is
-    // the derivative of S(q + ε q̇_D) (one dual lane; the time derivative the concept defines)
-    const vecN<T, N> qd = apply_S(c_, q, eta);
     using D1 = dual<T, 1>;
-    vecN<D1, N> q_eps = q.template cast<D1>();
+    vecN<T, N> q_local, qd_local, qdd_local;  // compile-time sizes: here; run-time: w's
+    vecN<D1, N> q_eps_local;
+    auto& q = detail::run_time_or_local<N>(w.q, q_local);
+    auto& qd = detail::run_time_or_local<N>(w.qd, qd_local);
+    auto& qdd = detail::run_time_or_local<N>(w.qdd, qdd_local);
+    auto& q_eps = detail::run_time_or_local<N>(w.q_eps, q_eps_local);
+    auto& eta = w.eta;
+    auto& eta_dot = w.eta_dot;
+    q = q_in.template cast<T>();
+    eta = eta_in.template cast<T>();
+    eta_dot = eta_dot_in.template cast<T>();
+    qd.resize(n);
+    qdd.resize(n);
+    // (q̇, q̈) = (Sη, Sη̇ + Ṡη): the constraint's lift into given storage where it has one,
+    // else q̇ here and q̈ from S's and Ṡ's nonzeros below
+    constexpr bool lifts_into = requires { c_.lift_into(q, eta, eta_dot, qd, qdd); };
+    if constexpr (lifts_into)
+      c_.lift_into(q, eta, eta_dot, qd, qdd);
+    else
+      qd = apply_S(c_, q, eta);
+    // S and Ṡ at once: S depends on q_D alone, so Ṡ(q, q̇) = Σ_{j∈D} ∂S/∂q_j q̇_j is the
+    // derivative of S(q + ε q̇_D) (one dual lane; the time derivative the concept defines)
+    q_eps = q.template cast<D1>();
     for (const int j : cols_) q_eps(j).derivative(0) = qd(j);
     auto& st = w.st;
     if constexpr (has_S_into<C, vecN<D1, N>, decltype(w.se)>) {
@@ -334,10 +374,12 @@ class inverse_dynamics_derivatives_fn {
     } else {
       st.read(c_.S(q_eps));
     }
-    // q̈ = Sη̇ + Ṡη, and rne's derivatives at the lifted state
-    vecN<T, N> qdd = vecN<T, N>::Zero(n);
-    for (const auto& e : st.nz) qdd(e.r) += e.s * eta_dot(e.c);
-    for (const auto& e : st.nz_dot) qdd(e.r) += e.s * eta(e.c);
+    // q̈ = Sη̇ + Ṡη (unless lifted above), and rne's derivatives at the lifted state
+    if constexpr (!lifts_into) {
+      qdd.setZero(n);
+      for (const auto& e : st.nz) qdd(e.r) += e.s * eta_dot(e.c);
+      for (const auto& e : st.nz_dot) qdd(e.r) += e.s * eta(e.c);
+    }
     derivatives(q, qd, qdd, out.id);
     const auto& r = out.id;
     // The constraint's pieces, by duals along q_j for the joints it depends on (j ∈ D): rows
@@ -350,7 +392,14 @@ class inverse_dynamics_derivatives_fn {
     // (K = 1, 2 or 4: a base's heading, a bicycle's heading and steering, more)
     const auto passes = [&]<int K>(std::integral_constant<int, K>) {
       using DK = dual<T, K>;
-      vecN<DK, N> x(n), xd(n), xdd(n);
+      auto& lanes = std::get<detail::dual_lanes<T, K>>(w.lanes);
+      vecN<DK, N> x_local, xd_local, xdd_local, v_local;
+      auto& x = detail::run_time_or_local<N>(lanes.x, x_local);
+      auto& xd = detail::run_time_or_local<N>(lanes.xd, xd_local);
+      auto& xdd = detail::run_time_or_local<N>(lanes.xdd, xdd_local);
+      x.resize(n);
+      xd.resize(n);
+      xdd.resize(n);
       const auto put = [&](int row0, int c0, const auto& y) {
         for (Eigen::Index i = 0; i < y.size(); ++i)
           for (int k = 0; k < K && c0 + k < nd; ++k) Jd(row0 + i, c0 + k) = y(i).derivative(k);
@@ -359,16 +408,25 @@ class inverse_dynamics_derivatives_fn {
         for (int i = 0; i < n; ++i) x(i) = DK(q(i));
         for (int k = 0; k < K && c0 + k < nd; ++k) x(cols_[static_cast<std::size_t>(c0 + k)]).derivative(k) = T(1);
         if constexpr (requires { c_.lift_into(x, eta, eta_dot, xd, xdd); }) {
-          c_.lift_into(x, eta, eta_dot, xd, xdd);  // the lift in one pass (constraints/stages.hpp)
+          // the lift in one pass, and P v with its memo, into the lanes' storage (the stages'
+          // own `into`, constraints/stages.hpp)
+          const auto memo = c_.lift_into(x, eta, eta_dot, xd, xdd);
+          auto& vd = detail::run_time_or_local<N>(lanes.v, v_local);
+          vd = v.template cast<DK>();
+          lanes.pv.resize(p);
+          project_.into(x, vd, memo, lanes.pv);
+          put(0, c0, xd);
+          put(n, c0, xdd);
+          put(2 * n, c0, lanes.pv);
         } else {
           const vecN<DK, M> e = eta.template cast<DK>(), ed = eta_dot.template cast<DK>();
           xd = apply_S(c_, x, e);
           xdd = apply_S(c_, x, ed);
           xdd += apply_Sdot(c_, x, xd, e);
+          put(0, c0, xd);
+          put(n, c0, xdd);
+          put(2 * n, c0, detail::solve_StE(c_, x, apply_St(c_, x, vecN<DK, N>(v.template cast<DK>()))));
         }
-        put(0, c0, xd);
-        put(n, c0, xdd);
-        put(2 * n, c0, detail::solve_StE(c_, x, apply_St(c_, x, vecN<DK, N>(v.template cast<DK>()))));
       }
     };
     if (nd == 1)
@@ -407,21 +465,25 @@ class inverse_dynamics_derivatives_fn {
       st.times_S(Z, Ded);
       st.St_times(v, Tau);
     };
-    out.tau.resize(m);
-    out.dq.resize(m, n);
-    out.deta.resize(m, m);
-    out.deta_dot.resize(m, m);
+    out.tau.resize(p);  // p = m but for a constraint with p actuators (wheeled_base)
+    out.dq.resize(p, n);
+    out.deta.resize(p, m);
+    out.deta_dot.resize(p, m);
     if constexpr (detail::projection_is_St<C, vecN<T, N>>) {
       fill(out.dq, out.deta, out.deta_dot, out.tau);
     } else {
       auto& StX = w.stx;
+      auto& X = w.solved;
       StX.resize(m, n + 2 * m + 1);
       fill(StX.leftCols(n), StX.middleCols(n, m), StX.middleCols(n + m, m), StX.col(n + 2 * m));
-      StX = detail::solve_StE(c_, q, std::move(StX));
-      out.tau = StX.col(n + 2 * m);
-      out.dq = StX.leftCols(n);
-      out.deta = StX.middleCols(n, m);
-      out.deta_dot = StX.middleCols(n + m, m);
+      if constexpr (requires { c_.solve_actuation_into(q, StX, X); })
+        c_.solve_actuation_into(q, StX, X);  // into kept storage (wheeled_base)
+      else
+        X = detail::solve_StE(c_, q, std::move(StX));
+      out.tau = X.col(n + 2 * m);
+      out.dq = X.leftCols(n);
+      out.deta = X.middleCols(n, m);
+      out.deta_dot = X.middleCols(n + m, m);
     }
     out.dqd_dq.setZero(n, n);
     for (int k = 0; k < nd; ++k) {
@@ -433,6 +495,7 @@ class inverse_dynamics_derivatives_fn {
 
   rne_derivatives_fn<S> d_;
   C c_;
+  project_fn<C> project_;  // P v into given storage (the dual passes)
   detail::object_tag id_ = detail::next_object_tag();  // copies share it: they hold the same constraint
   std::vector<int> cols_;  // D: the joints the constraint depends on
   std::vector<int> dcol_;  // per joint, its index in cols_ (−1 if not in D)
@@ -572,6 +635,10 @@ struct nh_fd_derivatives_result {
   state_space<T, Eigen::Dynamic, M> ss;  ///< A ((n+m) × (n+m)), B ((n+m) × p)
   /// The inverse dynamics' derivatives at (q, η, η̇): ∂τ/∂(q, η, η̇) (K = ∂τ/∂η̇ among them).
   nh_derivatives_result<T, M> id;
+  /// Scratch kept by evaluate for its next call (empty in a result that operator() returns):
+  /// the forward dynamics' own result (η̇, S(q), M_η; run-time-sized constraints) and K's LU.
+  nh_forward_dynamics_result<T, Eigen::Dynamic, M> fd;
+  Eigen::PartialPivLU<Eigen::Matrix<T, M, M>> lu;
 };
 
 /// A, B of a constrained tree's forward dynamics, analytically:
@@ -591,8 +658,9 @@ class nh_fd_derivatives_fn {
     auto J = id_(q, eta, ed);
     nh_fd_derivatives_result<typename decltype(J)::scalar_type, C::m_at_compile_time> out;
     out.id = std::move(J);
-    finish(q, tau, ed, out);
+    finish(q, tau, ed, id_.constraint().S(q), out);
     out.id.work = {};
+    out.lu = {};
     return out;
   }
   template <class Q, class E, class TAU, class Kin, class W>
@@ -602,45 +670,70 @@ class nh_fd_derivatives_fn {
     auto J = id_(q, eta, ed, w);
     nh_fd_derivatives_result<typename decltype(J)::scalar_type, C::m_at_compile_time> out;
     out.id = std::move(J);
-    finish(q, tau, ed, out);
+    finish(q, tau, ed, id_.constraint().S(q), out);
     out.id.work = {};
+    out.lu = {};
     return out;
   }
-  /// Into a result whose storage is reused. `out` must not alias the inputs; after an
-  /// exception its contents are unspecified.
+  /// Into a result whose storage is reused: no allocation once it has its sizes, where the
+  /// constraint is run-time sized and p = m (the redundant case, p > m, still forms S and SᵀE
+  /// anew). `out` must not alias the inputs; after an exception its contents are unspecified.
   template <class Q, class E, class TAU>
     requires detail::in_scalar<S, Q, E, TAU>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                 nh_fd_derivatives_result<S, C::m_at_compile_time>& out) const {
-    const auto ed = fd_(q, eta, tau);
-    id_.evaluate(q, eta, ed, out.id);
-    finish(q, tau, ed, out);
+    if constexpr (C::n_at_compile_time == Eigen::Dynamic) {
+      fd_.evaluate(q, eta, tau, out.fd);  // η̇ and S(q) into kept storage
+      id_.evaluate(q, eta, out.fd.eta_dot, out.id);
+      finish(q, tau, out.fd.eta_dot, out.fd.S, out);
+    } else {  // compile-time sizes: on the stack
+      const auto ed = fd_(q, eta, tau);
+      id_.evaluate(q, eta, ed, out.id);
+      finish(q, tau, ed, id_.constraint().S(q), out);
+    }
   }
   /// …with external wrenches in the model's scalar.
   template <class Q, class E, class TAU, class Kin>
     requires detail::in_scalar<S, Q, E, TAU>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                 const external_wrenches_fn<Kin, S>& w, nh_fd_derivatives_result<S, C::m_at_compile_time>& out) const {
-    const auto ed = fd_(q, eta, tau, w);
-    id_.evaluate(q, eta, ed, w, out.id);
-    finish(q, tau, ed, out);
+    if constexpr (C::n_at_compile_time == Eigen::Dynamic) {
+      fd_.evaluate(q, eta, tau, w, out.fd);
+      id_.evaluate(q, eta, out.fd.eta_dot, w, out.id);
+      finish(q, tau, out.fd.eta_dot, out.fd.S, out);
+    } else {
+      const auto ed = fd_(q, eta, tau, w);
+      id_.evaluate(q, eta, ed, w, out.id);
+      finish(q, tau, ed, id_.constraint().S(q), out);
+    }
   }
 
  private:
-  template <class Q, class TAU, class ED, class T, int M>
-  void finish(const Q& q, const TAU& tau, const ED& ed, nh_fd_derivatives_result<T, M>& out) const {
+  template <class Q, class TAU, class ED, class Sq, class T, int M>
+  void finish(const Q& q, const TAU& tau, const ED& ed, const Sq& s, nh_fd_derivatives_result<T, M>& out) const {
     const int n = id_.dof(), m = id_.m(), p = actuator_count(id_.constraint());
     const auto& J = out.id;
     out.eta_dot = ed.template cast<T>();
     out.ss.A.setZero(n + m, n + m);
     out.ss.B.setZero(n + m, p);
     out.ss.A.topLeftCorner(n, n) = J.dqd_dq;
-    out.ss.A.block(0, n, n, m) = id_.constraint().S(q).template cast<T>();
+    out.ss.A.block(0, n, n, m) = s.template cast<T>();
     if (p == m) {
-      const Eigen::PartialPivLU<Eigen::Matrix<T, M, M>> K(J.deta_dot);
-      out.ss.A.block(n, 0, m, n) = -K.solve(J.dq);
-      out.ss.A.block(n, n, m, m) = -K.solve(J.deta);
-      out.ss.B.bottomRows(m) = K.inverse();
+      // −K⁻¹ ∂τ/∂(q, η) and K⁻¹, each solved into its block and negated there (no temporaries)
+      out.lu.compute(J.deta_dot);
+      auto dq = out.ss.A.block(n, 0, m, n);
+      auto deta = out.ss.A.block(n, n, m, m);
+      dq = out.lu.solve(J.dq);
+      dq = -dq;
+      deta = out.lu.solve(J.deta);
+      deta = -deta;
+      // K⁻¹ in its block: P I, then L's and U's triangular solves in place (what
+      // lu.inverse() does, whose assignment to a block goes through temporaries)
+      auto k_inv = out.ss.B.bottomRows(m);  // zero (setZero above)
+      const auto& perm = out.lu.permutationP().indices();
+      for (int j = 0; j < m; ++j) k_inv(perm(j), j) = T(1);
+      out.lu.matrixLU().template triangularView<Eigen::UnitLower>().solveInPlace(k_inv);
+      out.lu.matrixLU().template triangularView<Eigen::Upper>().solveInPlace(k_inv);
     } else {  // more actuators than η (linearize.hpp, detail::redundant_eta_rows)
       detail::redundant_eta_rows(id_.constraint(), vecN<T, dynamic>(q.template cast<T>()), J.dq, J.deta, J.deta_dot, tau,
                                  J.tau, out.ss.A, out.ss.B);

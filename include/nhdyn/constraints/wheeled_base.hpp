@@ -550,6 +550,23 @@ class wheeled_base {
     const factored<T> f(*this, q, true);
     return actuation(q, f.sd.data(), r);
   }
+  /// The same into tau (p × r's columns, of the promoted scalar; resized if it is a matrix of
+  /// another size): no allocation once tau has that size. tau must not alias r.
+  template <class Q, class R, class Out>
+  void solve_actuation_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<R>& r,
+                            Eigen::PlainObjectBase<Out>& tau) const {
+    using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename R::Scalar>;
+    static_assert(std::is_same_v<typename Out::Scalar, T>, "tau's scalar is q's, r's and the model's promoted scalar");
+    check_q(q);
+    if (r.rows() != m()) detail::throw_size(r.rows(), m(), "Sᵀv");
+    tau.resize(p(), r.cols());
+    if (act_is_eta_) {  // SᵀE = I
+      tau = r.template cast<T>();
+      return;
+    }
+    const factored<T> f(*this, q, true);
+    actuation_into(q, f.sd.data(), r, tau);
+  }
 
   /// The constants in another scalar (a long-double reference, duals of the geometry).
   template <class U>
