@@ -8,8 +8,9 @@
 Every case of the new run (its run_name) replaces the same case of the main file, or is added;
 --skip leaves the main file's cases whose run_name matches REGEX as they were (cases that the
 filter caught but whose tables divide them by cases it did not re-run). The main file's context
-records the re-run (`partial_rerun`: its date and case names), which perf_table.py states at
-the top of the page and uses to draw no ratio across runs where it must not (the clang table).
+records the re-runs (`partial_reruns`: each one's date and the case names still its own), which
+perf_table.py states at the top of the page and uses to draw no ratio across runs where it must
+not (the clang table).
 """
 import argparse
 import json
@@ -32,7 +33,12 @@ def main():
     print(f"merge_bench: {len(names)} cases from {a.new} ({len(d['benchmarks']) - len(kept)} entries replaced, "
           f"{len(new)} written)")
     d["benchmarks"] = kept + new
-    d["context"]["partial_rerun"] = {"date": n["context"]["date"], "run_names": sorted(names)}
+    # every filtered run merged so far, each with the cases that are still its own
+    ctx = d["context"]
+    runs = ctx.pop("partial_reruns", None) or ([ctx.pop("partial_rerun")] if "partial_rerun" in ctx else [])
+    runs = [{"date": r["date"], "run_names": [x for x in r["run_names"] if x not in names]} for r in runs]
+    ctx["partial_reruns"] = [r for r in runs if r["run_names"]] + [
+        {"date": n["context"]["date"], "run_names": sorted(names)}]
     with open(a.main, "w") as f:
         json.dump(d, f, indent=1)
 

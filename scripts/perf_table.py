@@ -107,6 +107,13 @@ def slope(ns_, ts):
     return sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx
 
 
+def reruns(ctx):
+    """The filtered re-runs merged into the file (scripts/merge_bench.py), oldest first."""
+    if "partial_reruns" in ctx:
+        return ctx["partial_reruns"]
+    return [ctx["partial_rerun"]] if "partial_rerun" in ctx else []
+
+
 def tables(ctx, med, allocs, reps, cpu, compiler):
     g = med.get
     out = []
@@ -116,8 +123,7 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
                f"`{ctx.get('nhdyn_flags', '?')}`; KDL {ctx.get('kdl_flags', '?')}. Every figure is the "
                f"**median of {nrep} repetitions** of the CPU time per call in nanoseconds "
                f"(Google Benchmark `cpu_time`), from `docs/performance.json`.\n")
-    if "partial_rerun" in ctx:  # some cases re-run later by a filtered run, merged by name
-        pr = ctx["partial_rerun"]
+    for pr in reruns(ctx):  # some cases re-run later by filtered runs, merged by name
         fams = sorted({"/".join(r.split("/")[:1]) for r in pr["run_names"]})
         out[-1] = out[-1].rstrip("\n") + (f" The cases {', '.join(f'`{f}/…`' for f in fams)} were "
                                          f"re-run {pr['date']} (a filtered run, the same binary and flags; "
@@ -522,7 +528,7 @@ def main():
     text = tables(ctx, med, allocs, reps, a.cpu, a.compiler)
     if a.second:  # (after tables(): the second file's paired ratios, if any, do not reach them)
         _, second_med, _, _ = load(a.second)
-        rerun = frozenset(ctx.get("partial_rerun", {}).get("run_names", []))
+        rerun = frozenset(x for pr in reruns(ctx) for x in pr["run_names"])
         text += two_compilers(med, second_med, a.second_compiler, a.compiler, rerun)
     with open(a.doc) as f:
         doc = f.read()
