@@ -415,18 +415,16 @@ class inverse_dynamics_derivatives_fn {
           vd = v.template cast<DK>();
           lanes.pv.resize(p);
           project_.into(x, vd, memo, lanes.pv);
-          put(0, c0, xd);
-          put(n, c0, xdd);
           put(2 * n, c0, lanes.pv);
         } else {
           const vecN<DK, M> e = eta.template cast<DK>(), ed = eta_dot.template cast<DK>();
           xd = apply_S(c_, x, e);
           xdd = apply_S(c_, x, ed);
           xdd += apply_Sdot(c_, x, xd, e);
-          put(0, c0, xd);
-          put(n, c0, xdd);
           put(2 * n, c0, detail::solve_StE(c_, x, apply_St(c_, x, vecN<DK, N>(v.template cast<DK>()))));
         }
+        put(0, c0, xd);
+        put(n, c0, xdd);
       }
     };
     if (nd == 1)
@@ -682,33 +680,31 @@ class nh_fd_derivatives_fn {
     requires detail::in_scalar<S, Q, E, TAU>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                 nh_fd_derivatives_result<S, C::m_at_compile_time>& out) const {
-    if constexpr (C::n_at_compile_time == Eigen::Dynamic) {
-      fd_.evaluate(q, eta, tau, out.fd);  // η̇ and S(q) into kept storage
-      id_.evaluate(q, eta, out.fd.eta_dot, out.id);
-      finish(q, tau, out.fd.eta_dot, out.fd.S, out);
-    } else {  // compile-time sizes: on the stack
-      const auto ed = fd_(q, eta, tau);
-      id_.evaluate(q, eta, ed, out.id);
-      finish(q, tau, ed, id_.constraint().S(q), out);
-    }
+    evaluate_into(q, eta, tau, out);
   }
   /// …with external wrenches in the model's scalar.
   template <class Q, class E, class TAU, class Kin>
     requires detail::in_scalar<S, Q, E, TAU>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                 const external_wrenches_fn<Kin, S>& w, nh_fd_derivatives_result<S, C::m_at_compile_time>& out) const {
-    if constexpr (C::n_at_compile_time == Eigen::Dynamic) {
-      fd_.evaluate(q, eta, tau, w, out.fd);
-      id_.evaluate(q, eta, out.fd.eta_dot, w, out.id);
-      finish(q, tau, out.fd.eta_dot, out.fd.S, out);
-    } else {
-      const auto ed = fd_(q, eta, tau, w);
-      id_.evaluate(q, eta, ed, w, out.id);
-      finish(q, tau, ed, id_.constraint().S(q), out);
-    }
+    evaluate_into(q, eta, tau, out, w);
   }
 
  private:
+  /// evaluate, with or without the wrenches (`w...`: none or one).
+  template <class Q, class E, class TAU, class... W>
+  void evaluate_into(const Q& q, const E& eta, const TAU& tau, nh_fd_derivatives_result<S, C::m_at_compile_time>& out,
+                     const W&... w) const {
+    if constexpr (C::n_at_compile_time == Eigen::Dynamic) {
+      fd_.evaluate(q, eta, tau, w..., out.fd);  // η̇ and S(q) into kept storage
+      id_.evaluate(q, eta, out.fd.eta_dot, w..., out.id);
+      finish(q, tau, out.fd.eta_dot, out.fd.S, out);
+    } else {  // compile-time sizes: on the stack
+      const auto ed = fd_(q, eta, tau, w...);
+      id_.evaluate(q, eta, ed, w..., out.id);
+      finish(q, tau, ed, id_.constraint().S(q), out);
+    }
+  }
   template <class Q, class TAU, class ED, class Sq, class T, int M>
   void finish(const Q& q, const TAU& tau, const ED& ed, const Sq& s, nh_fd_derivatives_result<T, M>& out) const {
     const int n = id_.dof(), m = id_.m(), p = actuator_count(id_.constraint());

@@ -543,12 +543,9 @@ class wheeled_base {
   template <class Q, class R>
   auto solve_actuation(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<R>& r) const {
     using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename R::Scalar>;
-    check_q(q);
-    if (r.rows() != m()) detail::throw_size(r.rows(), m(), "Sᵀv");
-    using Out = Eigen::Matrix<T, dynamic, R::ColsAtCompileTime>;
-    if (act_is_eta_) return Out(r.template cast<T>());  // SᵀE = I
-    const factored<T> f(*this, q, true);
-    return actuation(q, f.sd.data(), r);
+    Eigen::Matrix<T, dynamic, R::ColsAtCompileTime> tau;
+    solve_actuation_into(q, r, tau);
+    return tau;
   }
   /// The same into tau (p × r's columns, of the promoted scalar; resized if it is a matrix of
   /// another size): no allocation once tau has that size. tau must not alias r.
@@ -954,16 +951,10 @@ class wheeled_base {
       out(Icol_[std::size_t(i)]) += s;
     }
   }
-  /// τ (p rows) from r = Sᵀv (m rows, any number of columns): actuators off the wheels' paths
-  /// take their η entry's force; the wheel-path actuators solve B τ_w = r_w, B = SᵀE's block
-  /// (|η ∩ W| × p_w), exactly when square, else with least Σ w τ²: τ_w = W⁻¹Bᵀ(BW⁻¹Bᵀ)⁻¹ r_w.
-  template <class Q, class T, class R>
-  auto actuation(const Q& q, const T* sd, const R& r) const {
-    Eigen::Matrix<promote_t<T, typename R::Scalar>, dynamic, R::ColsAtCompileTime> tau(p(), r.cols());
-    actuation_into(q, sd, r, tau);
-    return tau;
-  }
-  /// The same into tau (p × r's columns): no allocation.
+  /// τ (p rows) from r = Sᵀv (m rows, any number of columns) into tau (p × r's columns; no
+  /// allocation): actuators off the wheels' paths take their η entry's force; the wheel-path
+  /// actuators solve B τ_w = r_w, B = SᵀE's block (|η ∩ W| × p_w), exactly when square, else
+  /// with least Σ w τ²: τ_w = W⁻¹Bᵀ(BW⁻¹Bᵀ)⁻¹ r_w.
   template <class Q, class T, class R, class Out>
   void actuation_into(const Q& q, const T* sd, const R& r, Out& tau) const {
     using U = promote_t<T, typename R::Scalar>;
