@@ -245,3 +245,49 @@ TEST_CASE("forward_dynamics picks ABA or CRBA + LDLT as documented, with the sam
   CHECK_THROWS_WITH(forward_dynamics(idle)(VectorXd::Zero(1), VectorXd::Zero(1), VectorXd::Ones(1)),
                     Catch::Contains("mass matrix M(q) is not positive definite"));
 }
+
+TEST_CASE("forward_dynamics evaluate into a reused scratch: the call's numbers bit for bit, by either algorithm", "[aba]") {
+  std::mt19937_64 rng(2712);
+  const auto same = [](const VectorXd& a, const VectorXd& b) { return a.size() == b.size() && (a - b).cwiseAbs().maxCoeff() == 0.0; };
+  forward_dynamics_scratch<double, dynamic> ws;  // reused across sizes, algorithms and options
+  VectorXd qdd;
+  for (int n : {40, 6, 12, 1, 8}) {
+    const auto t = nhdyn_ref::random_tree(rng, n, 0.3, true);
+    const VectorXd q = random_vec(rng, n, 2), qd = random_vec(rng, n, 2), tau = random_vec(rng, n, 5);
+    for (fd_method m : {fd_method::automatic, fd_method::aba, fd_method::crba_ldlt})
+      for (rne_options o : {rne_options{}, rne_options{false, true}, rne_options{true, false}}) {
+        const auto fd = forward_dynamics(t, o, {.method = m});
+        INFO("n = " << n << ", method " << int(m) << ", gravity " << o.gravity << ", velocity " << o.velocity);
+        fd.evaluate(q, qd, tau, ws, qdd);
+        CHECK(same(qdd, fd(q, qd, tau)));
+        // and with friction on the bias side: τ − τ_f(q̇) solved the same way
+        const auto fdf = fd.with(viscous_friction(VectorXd::Constant(n, 0.7)));
+        fdf.evaluate(q, qd, tau, ws, qdd);
+        CHECK(same(qdd, fdf(q, qd, tau)));
+        CHECK(rel(qdd, fd(q, qd, VectorXd(tau - 0.7 * qd))) <= 1e-12);
+      }
+    // sizes and values checked as the call checks them, naming the argument
+    CHECK_THROWS_WITH(forward_dynamics(t).evaluate(q, qd, VectorXd::Zero(n + 1), ws, qdd), Catch::Contains("tau"));
+    VectorXd bad = tau;
+    bad(0) = std::numeric_limits<double>::quiet_NaN();
+    CHECK_THROWS_WITH(forward_dynamics(t).evaluate(q, qd, bad, ws, qdd), Catch::Contains("tau"));
+  }
+  // an ill-conditioned M (scaled pivot ratio past √(1/ε)): the switch to ABA, from the factor
+  // in the scratch
+  const auto light = mass_span_chain(rng, 16, 1);
+  const VectorXd q16 = random_vec(rng, 16, 2), qd16 = random_vec(rng, 16, 1), t16 = random_vec(rng, 16, 5);
+  REQUIRE(1.0 / ldlt_factor<double, dynamic>(mass_matrix(light)(q16)).min_scaled_pivot > 6.8e7);
+  forward_dynamics(light, {}, {.aba_from = 100}).evaluate(q16, qd16, t16, ws, qdd);
+  CHECK(same(qdd, aba(light)(q16, qd16, t16)));
+  // a chain (fixed size): the same numbers as its call
+  const auto p = presets::puma560();
+  Eigen::Matrix<double, 6, 1> q6 = random_vec(rng, 6, 2), qd6 = random_vec(rng, 6, 1), t6 = random_vec(rng, 6, 5), out6;
+  forward_dynamics_scratch<double, 6> ws6;
+  const auto fdp = forward_dynamics(p);
+  fdp.evaluate(q6, qd6, t6, ws6, out6);
+  CHECK(same(out6, fdp(q6, qd6, t6)));
+  // …and run-time sized (M and h then come as new matrices, moved into the scratch)
+  const auto fdr = forward_dynamics(p.dynamic_size());
+  fdr.evaluate(VectorXd(q6), VectorXd(qd6), VectorXd(t6), ws, qdd);
+  CHECK(same(qdd, out6));
+}

@@ -525,9 +525,11 @@ struct fd_derivatives_result {
     return s;
   }
   /// Scratch of the computation, kept by evaluate for its next call (empty in a result that
-  /// operator() returns): M's factorisation and the right-hand sides [∂τ/∂q  ∂τ/∂q̇  I].
+  /// operator() returns): M's factorisation and the right-hand sides [∂τ/∂q  ∂τ/∂q̇  I], and
+  /// the forward dynamics' own (M, h, their factor where CRBA + LDLᵀ answers).
   tree_ltl<T> factor;
   Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rhs;
+  forward_dynamics_scratch<T, Eigen::Dynamic> fd;
 };
 
 /// ∂q̈/∂(q, q̇, τ) of a tree's forward dynamics: `forward_dynamics_derivatives(t)(q, qd, tau [, w])`.
@@ -535,7 +537,8 @@ struct fd_derivatives_result {
 /// with it by the tree-sparse factorisation M = LᵀL (dynamics/tree_factor.hpp) of the M that
 /// rne_derivatives returns (refused, naming the model, when M is not positive definite).
 /// `evaluate(q, qd, tau [, w], out)` reuses out's matrices and scratch from call to call
-/// (inputs and wrenches in the model's scalar); q̈ comes from forward_dynamics as a new vector.
+/// (inputs and wrenches in the model's scalar): no heap allocation once out has the tree's size
+/// (with wrenches, Q_ext and τ + Q_ext are new vectors).
 template <class S>
 class fd_derivatives_fn {
  public:
@@ -565,7 +568,7 @@ class fd_derivatives_fn {
     requires detail::in_scalar<S, Q, QD, TAU>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                 fd_derivatives_result<S>& out) const {
-    out.qdd = fd_(q, qd, tau);
+    fd_.evaluate(q, qd, tau, out.fd, out.qdd);
     d_.evaluate(q, qd, out.qdd, out.id);
     solve(out);
   }
@@ -574,7 +577,8 @@ class fd_derivatives_fn {
     requires detail::in_scalar<S, Q, QD, TAU>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                 const external_wrenches_fn<Kin, S>& w, fd_derivatives_result<S>& out) const {
-    out.qdd = fd_(q, qd, tau, w);
+    detail::check_size(tau, dof(), "tau");
+    fd_.evaluate(q, qd, detail::plus_applied(tau, w, q), out.fd, out.qdd);
     d_.evaluate(q, qd, out.qdd, w, out.id);
     solve(out);
   }

@@ -18,6 +18,10 @@
 /// force to τ. `rne_options` drop gravity and/or the velocity terms, for both algorithms;
 /// `fd.with(friction(model))` puts the joints' friction on the bias side,
 /// q̈ = M⁻¹(τ − h − τ_f(q̇)) (dynamics/terms.hpp: the terms a computation includes).
+///
+/// `evaluate(q, q̇, τ, ws, q̈)` writes q̈ into a vector the caller reuses, with M, h and M's
+/// factor in a `forward_dynamics_scratch` reused as well: on a tree, no heap allocation once
+/// both have their size (by either algorithm; a friction model's τ_f(q̇) is a new vector).
 #include <cmath>
 #include <optional>
 
@@ -36,6 +40,15 @@ struct fd_options {
   fd_method method = fd_method::automatic;
   int aba_from = 9;                  ///< automatic: ABA from this many joints on
   double aba_scaled_condition = 0;   ///< automatic: ABA past this scaled pivot ratio of M (0: √(1/ε) of T)
+};
+
+/// What forward_dynamics_fn::evaluate keeps from call to call: M(q), h(q, q̇) and M's LDLᵀ
+/// factor (CRBA + LDLᵀ; ABA needs none of them).
+template <class T, int N>
+struct forward_dynamics_scratch {
+  Eigen::Matrix<T, N, N> M;
+  vecN<T, N> h;
+  ldlt<T, N> factor;
 };
 
 /// Model: chain<S, N> or tree<S> (N = dynamic).
@@ -98,33 +111,85 @@ class forward_dynamics_fn : public stage_tag {
     return (*this)(q, qd, detail::plus_applied(tau, fx, q));
   }
 
- private:
-  /// q̈ = M⁻¹(τ − h): CRBA + LDLᵀ or ABA as the options say.
-  template <class T, class Q, class QD, class TAU>
-  vecN<T, N> solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau) const {
-    using X = typename Q::Scalar;
-    if (fd_.method == fd_method::aba || (fd_.method == fd_method::automatic && n_ >= fd_.aba_from)) return by_aba<T>(q, qd, tau);
-    const auto h = rne_(q, qd, vecN<X, N>::Zero(q.size()));
-    const auto M = [&] {  // M in T (a dual τ makes T a dual while M(q) is not)
-      if constexpr (std::is_same_v<T, promote_t<S, X>>)
-        return M_(q);
-      else
-        return Eigen::Matrix<T, N, N>(M_(q).template cast<T>());
-    }();
-    const auto f = ldlt_factor<T, N>(M, "the mass matrix M(q)");
-    const double switch_at = fd_.aba_scaled_condition > 0 ? fd_.aba_scaled_condition : std::sqrt(default_max_pivot_ratio<T>());
-    if (fd_.method == fd_method::automatic && 1.0 / f.min_scaled_pivot > switch_at) return by_aba<T>(q, qd, tau);
-    vecN<T, N> qdd = f.solve(tau.template cast<T>() - h.template cast<T>());
-    detail::check_overflow(qdd, "forward_dynamics");
-    return qdd;
+  /// q̈ into qdd (resized to n), with M, h and M's factor in ws: the call's numbers, bit for
+  /// bit; storage reused from call to call (see the file comment). Inputs in the model's
+  /// scalar; qdd must not alias them.
+  template <class Q, class QD, class TAU>
+    requires std::is_same_v<typename Q::Scalar, S> && std::is_same_v<typename QD::Scalar, S> &&
+             std::is_same_v<typename TAU::Scalar, S>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
+                forward_dynamics_scratch<S, N>& ws, vecN<S, N>& qdd) const {
+    detail::check_size(tau, n_, "tau");
+    detail::check_finite(tau, "tau");
+    if (friction_) {
+      const vecN<S, N> net = tau - (*friction_)(qd).template cast<S>();
+      solve_into(q, qd, net, ws, qdd);
+    } else {
+      solve_into(q, qd, tau, ws, qdd);
+    }
   }
 
+ private:
+  /// q̈ = M⁻¹(τ − h) as a new vector (any scalar T: the inputs' promoted one).
   template <class T, class Q, class QD, class TAU>
-  vecN<T, N> by_aba(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau) const {
+  vecN<T, N> solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau) const {
+    forward_dynamics_scratch<T, N> ws;
+    vecN<T, N> qdd;
+    solve_into(q, qd, tau, ws, qdd);
+    return qdd;
+  }
+  /// q̈ = M⁻¹(τ − h): CRBA + LDLᵀ or ABA as the options say, into qdd (T: qdd's scalar).
+  template <class Q, class QD, class TAU, class T>
+  void solve_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
+                  forward_dynamics_scratch<T, N>& ws, vecN<T, N>& qdd) const {
+    using X = typename Q::Scalar;
+    qdd.resize(n_);
+    if (fd_.method == fd_method::aba || (fd_.method == fd_method::automatic && n_ >= fd_.aba_from))
+      return by_aba(q, qd, tau, qdd);
+    // on a tree in the model's scalar, M and h into ws (no allocation); otherwise as new
+    // matrices, M in T (a dual τ makes T a dual while M(q) is not)
+    constexpr bool into = std::is_same_v<Model, tree<S>> && std::is_same_v<T, S> && std::is_same_v<X, S> &&
+                          std::is_same_v<typename QD::Scalar, S>;
+    if constexpr (into) {
+      ws.h.resize(n_);
+      rne_.evaluate(q, qd, vecN<X, N>::Zero(n_), ws.h);
+      M_.evaluate(q, ws.M);
+    } else {
+      const auto put = [](auto& to, auto&& from) {  // moved in where the types agree: no copy
+        using To = std::decay_t<decltype(to)>;
+        if constexpr (std::is_same_v<std::decay_t<decltype(from)>, To>)
+          to = std::move(from);
+        else
+          to = from.template cast<typename To::Scalar>();
+      };
+      put(ws.h, rne_(q, qd, vecN<X, N>::Zero(q.size())));
+      put(ws.M, M_(q));
+    }
+    ldlt_factor_into<T, N>(ws.M, ws.factor, "the mass matrix M(q)");
+    const double switch_at = fd_.aba_scaled_condition > 0 ? fd_.aba_scaled_condition : std::sqrt(default_max_pivot_ratio<T>());
+    if (fd_.method == fd_method::automatic && 1.0 / ws.factor.min_scaled_pivot > switch_at)
+      return by_aba(q, qd, tau, qdd);
+    qdd = tau.template cast<T>() - ws.h;
+    ws.factor.solve_in_place(qdd);
+    detail::check_overflow(qdd, "forward_dynamics");
+  }
+
+  /// q̈ by ABA into qdd (in place where its scalar is ABA's own for these inputs).
+  template <class Q, class QD, class TAU, class T>
+  void by_aba(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
+              vecN<T, N>& qdd) const {
     using X = typename QD::Scalar;
-    if (opt_.velocity) return vecN<T, N>((*aba_)(q, qd, tau).template cast<T>());  // aba checks q̇
+    const auto run = [&](const auto& v) {  // v: q̇, or zero without velocity terms
+      using V = std::decay_t<decltype(v)>;
+      using R = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename V::Scalar>, typename TAU::Scalar>;
+      if constexpr (std::is_same_v<R, T>)
+        aba_->evaluate(q, v, tau, qdd);
+      else
+        qdd = (*aba_)(q, v, tau).template cast<T>();
+    };
+    if (opt_.velocity) return run(qd.derived());  // aba checks q̇
     detail::check_size(qd, n_, "qd");  // without velocity terms q̇ is not read, as in rne
-    return vecN<T, N>((*aba_)(q, vecN<X, dynamic>::Zero(n_), tau).template cast<T>());
+    run(vecN<X, dynamic>::Zero(n_));
   }
 
   mass_matrix_type M_;
