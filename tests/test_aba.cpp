@@ -255,11 +255,19 @@ TEST_CASE("forward_dynamics evaluate into a reused scratch: the call's numbers b
     const auto t = nhdyn_ref::random_tree(rng, n, 0.3, true);
     const VectorXd q = random_vec(rng, n, 2), qd = random_vec(rng, n, 2), tau = random_vec(rng, n, 5);
     for (fd_method m : {fd_method::automatic, fd_method::aba, fd_method::crba_ldlt})
-      for (rne_options o : {rne_options{}, rne_options{false, true}, rne_options{true, false}}) {
+      for (rne_options o : {rne_options{}, rne_options{false, true}, rne_options{true, false}, rne_options{false, false}}) {
         const auto fd = forward_dynamics(t, o, {.method = m});
         INFO("n = " << n << ", method " << int(m) << ", gravity " << o.gravity << ", velocity " << o.velocity);
         fd.evaluate(q, qd, tau, ws, qdd);
         CHECK(same(qdd, fd(q, qd, tau)));
+        // both, against the chosen route rebuilt from its parts (zero tolerance): ABA on the
+        // tree as the options make it, or LDLᵀ of CRBA's M solving τ − rne(q, q̇, 0)
+        VectorXd expect;
+        if (m == fd_method::aba || (m == fd_method::automatic && n >= fd_options{}.aba_from))
+          expect = aba(o.gravity ? t : t.with_gravity(vec3<double>::Zero()))(q, o.velocity ? qd : VectorXd::Zero(n), tau);
+        else
+          expect = ldlt_factor<double, dynamic>(mass_matrix(t)(q)).solve(VectorXd(tau - rne(t, o)(q, qd, VectorXd::Zero(n))));
+        CHECK(same(qdd, expect));
         // and with friction on the bias side: τ − τ_f(q̇) solved the same way
         const auto fdf = fd.with(viscous_friction(VectorXd::Constant(n, 0.7)));
         fdf.evaluate(q, qd, tau, ws, qdd);
@@ -279,6 +287,21 @@ TEST_CASE("forward_dynamics evaluate into a reused scratch: the call's numbers b
   REQUIRE(1.0 / ldlt_factor<double, dynamic>(mass_matrix(light)(q16)).min_scaled_pivot > 6.8e7);
   forward_dynamics(light, {}, {.aba_from = 100}).evaluate(q16, qd16, t16, ws, qdd);
   CHECK(same(qdd, aba(light)(q16, qd16, t16)));
+  // a dual τ through the LDLᵀ route (M and h in double, then cast): the double call's values
+  // and ∂q̈/∂τ_0 = M⁻¹'s first column
+  {
+    const auto t = nhdyn_ref::random_tree(rng, 6, 0.3, true);
+    const VectorXd q = random_vec(rng, 6, 2), qd = random_vec(rng, 6, 2), tau = random_vec(rng, 6, 5);
+    const auto fd = forward_dynamics(t, {}, {.method = fd_method::crba_ldlt});
+    using D = dual<double, 1>;
+    vecN<D, dynamic> td = tau.cast<D>();
+    td(0) = D(tau(0), {1.0});
+    const auto qd_dual = fd(q, qd, td);
+    VectorXd val(6), col(6);
+    for (int i = 0; i < 6; ++i) val(i) = qd_dual(i).value(), col(i) = qd_dual(i).derivative(0);
+    CHECK(rel(val, fd(q, qd, tau)) <= 1e-15);
+    CHECK(rel(col, mass_matrix(t)(q).inverse().col(0)) <= 1e-10);
+  }
   // a chain (fixed size): the same numbers as its call
   const auto p = presets::puma560();
   Eigen::Matrix<double, 6, 1> q6 = random_vec(rng, 6, 2), qd6 = random_vec(rng, 6, 1), t6 = random_vec(rng, 6, 5), out6;

@@ -537,8 +537,9 @@ struct fd_derivatives_result {
 /// with it by the tree-sparse factorisation M = LᵀL (dynamics/tree_factor.hpp) of the M that
 /// rne_derivatives returns (refused, naming the model, when M is not positive definite).
 /// `evaluate(q, qd, tau [, w], out)` reuses out's matrices and scratch from call to call
-/// (inputs and wrenches in the model's scalar): no heap allocation once out has the tree's size
-/// (with wrenches, Q_ext and τ + Q_ext are new vectors).
+/// (inputs and wrenches in the model's scalar): no heap allocation once out has the tree's size,
+/// up to 51 bodies (the kernels' stack scratch; with wrenches, Q_ext and τ + Q_ext are new
+/// vectors).
 template <class S>
 class fd_derivatives_fn {
  public:

@@ -21,7 +21,9 @@
 ///
 /// `evaluate(q, q̇, τ, ws, q̈)` writes q̈ into a vector the caller reuses, with M, h and M's
 /// factor in a `forward_dynamics_scratch` reused as well: on a tree, no heap allocation once
-/// both have their size (by either algorithm; a friction model's τ_f(q̇) is a new vector).
+/// both have their size, up to 51 bodies by ABA (its stack scratch, aba.hpp; beyond, that
+/// scratch is on the heap) and far beyond by CRBA + LDLᵀ; with a friction model τ_f(q̇) and
+/// τ − τ_f are new vectors.
 #include <cmath>
 #include <optional>
 
@@ -119,6 +121,8 @@ class forward_dynamics_fn : public stage_tag {
              std::is_same_v<typename TAU::Scalar, S>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                 forward_dynamics_scratch<S, N>& ws, vecN<S, N>& qdd) const {
+    detail::check_size(q, n_, "q");  // before qdd is resized: an aliased input of the wrong size
+    detail::check_size(qd, n_, "qd");
     detail::check_size(tau, n_, "tau");
     detail::check_finite(tau, "tau");
     if (friction_) {
