@@ -302,13 +302,16 @@ TEST_CASE("forward_dynamics evaluate into a reused scratch: the call's numbers b
     CHECK(rel(val, fd(q, qd, tau)) <= 1e-15);
     CHECK(rel(col, mass_matrix(t)(q).inverse().col(0)) <= 1e-10);
   }
-  // a chain (fixed size): the same numbers as its call
+  // a chain (fixed size, 6 joints: CRBA + LDLᵀ): its call's numbers, and the route rebuilt
+  // from the chain's own M and rne (zero tolerance)
   const auto p = presets::puma560();
   Eigen::Matrix<double, 6, 1> q6 = random_vec(rng, 6, 2), qd6 = random_vec(rng, 6, 1), t6 = random_vec(rng, 6, 5), out6;
   forward_dynamics_scratch<double, 6> ws6;
   const auto fdp = forward_dynamics(p);
   fdp.evaluate(q6, qd6, t6, ws6, out6);
   CHECK(same(out6, fdp(q6, qd6, t6)));
+  const Eigen::Matrix<double, 6, 1> h6 = rne(p)(q6, qd6, Eigen::Matrix<double, 6, 1>::Zero());
+  CHECK(same(out6, ldlt_factor<double, 6>(mass_matrix(p)(q6)).solve(Eigen::Matrix<double, 6, 1>(t6 - h6))));
   // …and run-time sized (M and h then come as new matrices, moved into the scratch)
   const auto fdr = forward_dynamics(p.dynamic_size());
   fdr.evaluate(VectorXd(q6), VectorXd(qd6), VectorXd(t6), ws, qdd);
