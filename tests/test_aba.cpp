@@ -11,7 +11,9 @@
 #include <nhdyn/scalar/interval.hpp>
 #include <nhdyn/scalar/multiprecision.hpp>
 #include <limits>
+#include <memory>
 #include <random>
+#include <thread>
 
 #include "reference/random_tree.hpp"
 
@@ -86,6 +88,54 @@ TEST_CASE("aba into reused storage (evaluate) gives the call's numbers, also ove
     CHECK_THROWS_WITH(fd.evaluate(VectorXd::Zero(n), VectorXd::Zero(n), VectorXd::Zero(n), wrong),
                       Catch::Contains("qdd") && Catch::Contains(std::to_string(n)));
   }
+}
+
+TEST_CASE("scratch beyond the stack: a block its thread keeps, one per nested buffer, elements fresh on reuse", "[aba]") {
+  using detail::small_buffer;
+  struct counted {
+    int v = 7;  // not trivial: each element must come default-initialised, new or reused
+  };
+  const counted* outer = nullptr;
+  {
+    small_buffer<counted, dynamic, 4> a(10);  // beyond its 4 inline elements: a heap block
+    outer = a.data();
+    for (int i = 0; i < 10; ++i) CHECK(a[i].v == 7);
+    for (int i = 0; i < 10; ++i) a[i].v = -1;
+    {
+      small_buffer<counted, dynamic, 4> b(10);  // while a holds its block: a block of its own
+      CHECK(b.data() != a.data());
+      for (int i = 0; i < 10; ++i) CHECK(b[i].v == 7);
+    }
+    small_buffer<counted, dynamic, 4> small(3);  // within the inline capacity
+    CHECK(small[2].v == 7);
+  }
+  // memory of a's size held meanwhile, so that malloc could not give a's memory back to c:
+  // c finds a's block only in the thread's list
+  const auto hold = std::make_unique<counted[]>(10);
+  {
+    small_buffer<counted, dynamic, 4> c(8);  // a's block again (the last given back), fresh
+    CHECK(c.data() == outer);
+    for (int i = 0; i < 8; ++i) CHECK(c[i].v == 7);
+  }
+  // Each thread has its own blocks: ABA on an 80-body tree (beyond its 51-body stack part)
+  // in two threads at once gives the single-threaded q̈ bit for bit in both.
+  std::mt19937_64 rng(77);
+  const auto t = nhdyn_ref::random_tree(rng, 80, 0.4, true);
+  const VectorXd q = random_vec(rng, 80, 2), qd = random_vec(rng, 80, 2), tau = random_vec(rng, 80, 5);
+  const VectorXd want = aba(t)(q, qd, tau);
+  VectorXd got[2];
+  {
+    std::thread th[2];
+    for (int k = 0; k < 2; ++k)
+      th[k] = std::thread([&, k] {
+        VectorXd a(80);
+        for (int r = 0; r < 20; ++r) aba(t).evaluate(q, qd, tau, a);
+        got[k] = a;
+      });
+    for (auto& x : th) x.join();
+  }
+  CHECK(got[0] == want);
+  CHECK(got[1] == want);
 }
 
 TEST_CASE("aba far from the world origin: translating the whole tree leaves q̈ unchanged", "[aba]") {
@@ -312,8 +362,26 @@ TEST_CASE("forward_dynamics evaluate into a reused scratch: the call's numbers b
   CHECK(same(out6, fdp(q6, qd6, t6)));
   const Eigen::Matrix<double, 6, 1> h6 = rne(p)(q6, qd6, Eigen::Matrix<double, 6, 1>::Zero());
   CHECK(same(out6, ldlt_factor<double, 6>(mass_matrix(p)(q6)).solve(Eigen::Matrix<double, 6, 1>(t6 - h6))));
-  // …and run-time sized (M and h then come as new matrices, moved into the scratch)
-  const auto fdr = forward_dynamics(p.dynamic_size());
+  // …and run-time sized (M and h into the scratch by the chain's rne and CRBA evaluate)
+  const auto pd = p.dynamic_size();
+  const auto fdr = forward_dynamics(pd);
   fdr.evaluate(VectorXd(q6), VectorXd(qd6), VectorXd(t6), ws, qdd);
   CHECK(same(qdd, out6));
+  // the chain's rne and CRBA evaluate: their calls' numbers, into storage of another size first
+  VectorXd v(6);
+  Eigen::MatrixXd H = Eigen::MatrixXd::Ones(2, 3);
+  const VectorXd qdd6 = random_vec(rng, 6, 3);
+  rne(pd).evaluate(VectorXd(q6), VectorXd(qd6), qdd6, v);
+  CHECK(same(v, rne(pd)(VectorXd(q6), VectorXd(qd6), qdd6)));
+  mass_matrix(pd).evaluate(VectorXd(q6), H);
+  CHECK((H.rows() == 6 && H == mass_matrix(pd)(VectorXd(q6))));
+  VectorXd wrong(5);
+  CHECK_THROWS_WITH(rne(pd).evaluate(VectorXd(q6), VectorXd(qd6), qdd6, wrong), Catch::Contains("v"));
+  // with friction, τ − τ_f in the scratch: the call's numbers, and the route rebuilt from the
+  // parts (τ_f by the friction model)
+  const auto fric = viscous_friction(VectorXd::Constant(6, 0.7));
+  const auto fdrf = fdr.with(fric);
+  fdrf.evaluate(VectorXd(q6), VectorXd(qd6), VectorXd(t6), ws, qdd);
+  CHECK(same(qdd, fdrf(VectorXd(q6), VectorXd(qd6), VectorXd(t6))));
+  CHECK(same(qdd, fdr(VectorXd(q6), VectorXd(qd6), VectorXd(VectorXd(t6) - fric(VectorXd(qd6))))));
 }

@@ -90,7 +90,8 @@ struct scratch_inverse_dynamics : Composed {
     }
     const int n = c.dof();
     constexpr int NC = C::n_at_compile_time;
-    // Run-time sized: on the stack up to 256 joints, beyond on the heap. Compile-time sized:
+    // Run-time sized: on the stack up to 256 joints, beyond in a heap block the thread keeps
+    // (detail/small_buffer.hpp). Compile-time sized:
     // on the stack, and q̇, q̈, v never move between stages (a fixed-size Eigen "move" is a
     // copy, and a vector load of just-stored scalars stalls store-to-load forwarding).
     using buffer = std::conditional_t<NC == dynamic, small_buffer<T, dynamic, 256>, small_buffer<T, NC>>;

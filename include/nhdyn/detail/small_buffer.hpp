@@ -1,13 +1,27 @@
 #pragma once
 /// \file detail/small_buffer.hpp
 /// Scratch storage for one call of an algorithm: on the stack when the size is known at
-/// compile time or small enough, on the heap only for very long run-time-sized chains.
+/// compile time or small enough; beyond, in a heap block that each thread keeps for its next
+/// call, so that a call on a tree of any size allocates nothing once its thread has met that
+/// size.
 #include <array>
 #include <cstddef>
 #include <memory>
 #include <new>
 #include <type_traits>
+#include <utility>
 #include <vector>
+
+#if defined(__SANITIZE_ADDRESS__)
+#define NHDYN_SCRATCH_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define NHDYN_SCRATCH_ASAN 1
+#endif
+#endif
+#ifdef NHDYN_SCRATCH_ASAN
+#include <sanitizer/asan_interface.h>
+#endif
 
 namespace nhdyn::detail {
 
@@ -16,25 +30,119 @@ namespace nhdyn::detail {
 template <class T>
 inline constexpr std::size_t inline_capacity = 32768 / sizeof(T) > 32 ? 32768 / sizeof(T) : 32;
 
+/// The heap blocks (raw storage for T, no object in them at rest) that small_buffers beyond
+/// their inline capacity borrow: one list per thread and element type, used last in, first out
+/// (a call nested in another's, which runs while the outer one holds its block, gets a block
+/// of its own and gives it back first). A block grows when a call needs more than it holds
+/// (that call allocates); the blocks live until the thread ends: per thread and element type,
+/// as many as calls nest (16 kept at most), each the size of the largest scratch it served.
+/// After the thread's list is gone (a kernel run from a destructor at the thread's or the
+/// program's end), each buffer allocates and frees its own block.
+template <class T>
+class scratch_blocks {
+ public:
+  class block {
+   public:
+    block() = default;
+    explicit block(std::size_t n)
+        : data_(static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(alignof(T))))), size_(n) {}
+    block(block&& o) noexcept : data_(std::exchange(o.data_, nullptr)), size_(std::exchange(o.size_, 0)) {}
+    block& operator=(block&& o) noexcept {
+      if (this != &o) {
+        release();
+        data_ = std::exchange(o.data_, nullptr);
+        size_ = std::exchange(o.size_, 0);
+      }
+      return *this;
+    }
+    ~block() { release(); }
+    T* data() const { return data_; }
+    std::size_t size() const { return size_; }
+
+   private:
+    void release() noexcept {
+      if (data_) ::operator delete(static_cast<void*>(data_), std::align_val_t(alignof(T)));
+      data_ = nullptr;
+      size_ = 0;
+    }
+    T* data_ = nullptr;
+    std::size_t size_ = 0;
+  };
+
+  /// Raw storage for at least n elements (under AddressSanitizer, what lies past n is poisoned:
+  /// an overrun is caught as in a block of exactly n).
+  static block take(std::size_t n) {
+    block b;
+    if (auto* free = list(); free && !free->empty()) {
+      b = std::move(free->back());
+      free->pop_back();
+    }
+    if (b.size() < n) b = block(n);
+#ifdef NHDYN_SCRATCH_ASAN
+    ASAN_POISON_MEMORY_REGION(b.data() + n, (b.size() - n) * sizeof(T));
+#endif
+    return b;
+  }
+  /// Back for the next call (freed when the list is full or gone).
+  static void give_back(block&& b) noexcept {
+#ifdef NHDYN_SCRATCH_ASAN
+    ASAN_UNPOISON_MEMORY_REGION(b.data(), b.size() * sizeof(T));
+#endif
+    if (auto* free = list(); free && free->size() < free->capacity()) free->push_back(std::move(b));  // never allocates
+  }
+
+ private:
+  struct holder {
+    std::vector<block> free;
+    bool& gone;
+    explicit holder(bool& g) : gone(g) {
+      try {
+        free.reserve(16);
+      } catch (...) {  // no room for the list: every buffer then allocates its own block
+      }
+    }
+    ~holder() { gone = true; }
+  };
+  /// This thread's list, or null once it is destroyed (a trivially destructible flag says so).
+  static std::vector<block>* list() noexcept {
+    thread_local bool gone = false;
+    if (gone) return nullptr;
+    thread_local holder h(gone);
+    return &h.free;
+  }
+};
+
 /// n elements of T, default-initialised (a trivial T is left uninitialised: the algorithms
-/// write every element before they read it, and a call does not pay for zeroing). Compile-time N: std::array. Run time: inline
-/// storage for up to Cap elements (only n of them are constructed), heap beyond.
+/// write every element before they read it, and a call does not pay for zeroing). Compile-time
+/// N: std::array. Run time: inline storage for up to Cap elements, beyond a block borrowed from
+/// this thread's scratch_blocks<T> and given back when the buffer goes; either way only n
+/// elements are constructed, and destroyed with the buffer.
 template <class T, int N, std::size_t Cap = inline_capacity<T>>
 class small_buffer {
  public:
   explicit small_buffer(int n) {
     if (static_cast<std::size_t>(n) > Cap) {
-      heap_.reset(new T[static_cast<std::size_t>(n)]);  // default-initialised: not zeroed either
-      data_ = heap_.get();
+      heap_ = scratch_blocks<T>::take(static_cast<std::size_t>(n));
+      data_ = heap_.data();
     } else {
       data_ = std::launder(reinterpret_cast<T*>(&inline_));
-      if constexpr (!std::is_trivially_default_constructible_v<T> || !std::is_trivially_destructible_v<T>) {
-        for (int i = 0; i < n; ++i) ::new (static_cast<void*>(data_ + i)) T;
-        constructed_ = n;
+    }
+    if constexpr (!std::is_trivially_default_constructible_v<T> || !std::is_trivially_destructible_v<T>) {
+      int i = 0;
+      try {
+        for (; i < n; ++i) ::new (static_cast<void*>(data_ + i)) T;
+      } catch (...) {
+        std::destroy_n(data_, i);
+        if (heap_.data()) scratch_blocks<T>::give_back(std::move(heap_));
+        throw;
       }
+      constructed_ = n;
     }
   }
-  ~small_buffer() { std::destroy_n(data_, constructed_); }
+  ~small_buffer() {
+    std::destroy_n(data_, constructed_);
+    if (heap_.data()) scratch_blocks<T>::give_back(std::move(heap_));
+  }
   small_buffer(const small_buffer&) = delete;
   small_buffer& operator=(const small_buffer&) = delete;
   T& operator[](int i) { return data_[i]; }
@@ -44,7 +152,7 @@ class small_buffer {
 
  private:
   alignas(T) std::byte inline_[sizeof(T) * Cap];
-  std::unique_ptr<T[]> heap_;
+  typename scratch_blocks<T>::block heap_;
   T* data_ = nullptr;
   int constructed_ = 0;
 };

@@ -21,7 +21,8 @@
 /// rotation: three 3×3 cross-product blocks instead of two 6×6 products with X_i), the
 /// rigid-body inertia is rotated once per body in pass 1, S_i is the world joint axis in one
 /// half of a 6-vector, (7.38)/(7.39) share one rank-one update, and one scratch buffer per call
-/// lives on the stack for up to 51 bodies (32 KiB). Origins stay on the bodies (not at the world
+/// lives on the stack for up to 51 bodies (32 KiB; beyond, in a heap block the thread keeps for
+/// its next call, detail/small_buffer.hpp). Origins stay on the bodies (not at the world
 /// origin, as Pinocchio's ABA): inertias about a far origin grow as m·|p|² and lose digits —
 /// on tests/test_aba.cpp's random trees of up to 40 bodies, q̈ about the world origin was
 /// 5e-10 from CRBA + LDLᵀ, about the bodies' origins 4.8e-13 (the 6×6 reference: 1.2e-12).

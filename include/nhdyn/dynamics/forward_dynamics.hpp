@@ -19,11 +19,10 @@
 /// `fd.with(friction(model))` puts the joints' friction on the bias side,
 /// q̈ = M⁻¹(τ − h − τ_f(q̇)) (dynamics/terms.hpp: the terms a computation includes).
 ///
-/// `evaluate(q, q̇, τ, ws, q̈)` writes q̈ into a vector the caller reuses, with M, h and M's
-/// factor in a `forward_dynamics_scratch` reused as well: on a tree, no heap allocation once
-/// both have their size, up to 51 bodies by ABA (its stack scratch, aba.hpp; beyond, that
-/// scratch is on the heap) and far beyond by CRBA + LDLᵀ; with a friction model τ_f(q̇) and
-/// τ − τ_f are new vectors.
+/// `evaluate(q, q̇, τ, ws, q̈)` writes q̈ into a vector the caller reuses, with M, h, M's
+/// factor and (with friction) τ − τ_f(q̇) in a `forward_dynamics_scratch` reused as well: on a
+/// chain or a tree of any size, no heap allocation once both have their size (ABA's scratch
+/// beyond its stack part, 51 bodies, is a block its thread keeps: detail/small_buffer.hpp).
 #include <cmath>
 #include <optional>
 
@@ -45,12 +44,13 @@ struct fd_options {
 };
 
 /// What forward_dynamics_fn::evaluate keeps from call to call: M(q), h(q, q̇) and M's LDLᵀ
-/// factor (CRBA + LDLᵀ; ABA needs none of them).
+/// factor (CRBA + LDLᵀ; ABA needs none of them), and τ − τ_f(q̇) with a friction model (both).
 template <class T, int N>
 struct forward_dynamics_scratch {
   Eigen::Matrix<T, N, N> M;
   vecN<T, N> h;
   ldlt<T, N> factor;
+  vecN<T, N> net;  ///< τ − τ_f(q̇), with a friction model
 };
 
 /// Model: chain<S, N> or tree<S> (N = dynamic).
@@ -113,8 +113,8 @@ class forward_dynamics_fn : public stage_tag {
     return (*this)(q, qd, detail::plus_applied(tau, fx, q));
   }
 
-  /// q̈ into qdd (resized to n), with M, h and M's factor in ws: the call's numbers, bit for
-  /// bit; storage reused from call to call (see the file comment). Inputs in the model's
+  /// q̈ into qdd (resized to n), with M, h, M's factor and τ − τ_f in ws: the call's numbers,
+  /// bit for bit; storage reused from call to call (see the file comment). Inputs in the model's
   /// scalar; qdd must not alias them.
   template <class Q, class QD, class TAU>
     requires std::is_same_v<typename Q::Scalar, S> && std::is_same_v<typename QD::Scalar, S> &&
@@ -125,9 +125,10 @@ class forward_dynamics_fn : public stage_tag {
     detail::check_size(qd, n_, "qd");
     detail::check_size(tau, n_, "tau");
     detail::check_finite(tau, "tau");
-    if (friction_) {
-      const vecN<S, N> net = tau - (*friction_)(qd).template cast<S>();
-      solve_into(q, qd, net, ws, qdd);
+    if (friction_) {  // τ − τ_f(q̇) in ws.net: τ_f first, then τ minus it, entry by entry
+      friction_->evaluate(qd, ws.net);
+      ws.net = tau - ws.net;
+      solve_into(q, qd, ws.net, ws, qdd);
     } else {
       solve_into(q, qd, tau, ws, qdd);
     }
@@ -150,10 +151,9 @@ class forward_dynamics_fn : public stage_tag {
     qdd.resize(n_);
     if (fd_.method == fd_method::aba || (fd_.method == fd_method::automatic && n_ >= fd_.aba_from))
       return by_aba(q, qd, tau, qdd);
-    // on a tree in the model's scalar, M and h into ws (no allocation); otherwise as new
-    // matrices, M in T (a dual τ makes T a dual while M(q) is not)
-    constexpr bool into = std::is_same_v<Model, tree<S>> && std::is_same_v<T, S> && std::is_same_v<X, S> &&
-                          std::is_same_v<typename QD::Scalar, S>;
+    // in the model's scalar, M and h into ws (no allocation); otherwise as new matrices, M in
+    // T (a dual τ makes T a dual while M(q) is not)
+    constexpr bool into = std::is_same_v<T, S> && std::is_same_v<X, S> && std::is_same_v<typename QD::Scalar, S>;
     if constexpr (into) {
       ws.h.resize(n_);
       rne_.evaluate(q, qd, vecN<X, N>::Zero(n_), ws.h);

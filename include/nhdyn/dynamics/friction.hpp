@@ -107,12 +107,17 @@ class friction_fn : public stage_tag {
     detail::check_size(qd, dof(), "qd");
     detail::check_finite(qd, "qd");
     Eigen::Matrix<T, Eigen::Dynamic, 1> tau(dof());
-    for (int i = 0; i < dof(); ++i) {
-      const auto& f = f_[std::size_t(i)];
-      const T x = T(qd(i));
-      tau(i) = T(f.viscous) * x + detail::coulomb_term(x, f.coulomb_pos, f.coulomb_neg, law_);
-    }
+    fill(qd, tau);
     return tau;
+  }
+  /// τ_f into out (resized to n; no allocation once it has that size), each entry computed as
+  /// the call computes it and then converted to out's scalar.
+  template <class QD, class Out>
+  void evaluate(const Eigen::MatrixBase<QD>& qd, Eigen::PlainObjectBase<Out>& out) const {
+    detail::check_size(qd, dof(), "qd");
+    detail::check_finite(qd, "qd");
+    out.resize(dof());
+    fill(qd, out);
   }
   template <class Q, class QD, class QDD>
   auto operator()(const Eigen::MatrixBase<Q>&, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>&) const {
@@ -120,6 +125,17 @@ class friction_fn : public stage_tag {
   }
 
  private:
+  template <class QD, class Out>
+  void fill(const Eigen::MatrixBase<QD>& qd, Out& tau) const {
+    using T = promote_t<double, typename QD::Scalar>;
+    using R = typename Out::Scalar;
+    for (int i = 0; i < dof(); ++i) {
+      const auto& f = f_[std::size_t(i)];
+      const T x = T(qd(i));
+      tau(i) = R(T(f.viscous) * x + detail::coulomb_term(x, f.coulomb_pos, f.coulomb_neg, law_));
+    }
+  }
+
   std::vector<joint_friction> f_;
   coulomb_law law_;
 };

@@ -57,13 +57,30 @@ class mass_matrix_fn : public stage_tag {
     detail::check_size(q, n_, "q");
     detail::check_finite(q, "q");
     Eigen::Matrix<T, N, N> M(n_, n_);
-    kernel<T>(q, M);
-    for (int i = 0; i < n_; ++i)  // the drives' rotor inertias (link::armature)
-      if (links_[std::size_t(i)].has_armature) M(i, i) += T(links_[std::size_t(i)].Ia);
+    fill(q, M);
     return M;
+  }
+  /// M(q) into M, resized to n×n (no allocation once it has that size): the call's numbers,
+  /// bit for bit. q in the model's scalar.
+  template <class Q>
+    requires std::is_same_v<typename Q::Scalar, S>
+  void evaluate(const Eigen::MatrixBase<Q>& q, Eigen::Matrix<S, N, N>& M) const {
+    detail::check_size(q, n_, "q");
+    detail::check_finite(q, "q");
+    M.resize(n_, n_);
+    fill(q, M);
   }
 
  private:
+  /// The kernel, then the drives' rotor inertias (link::armature) on the diagonal.
+  template <class Q, class Out>
+  void fill(const Eigen::MatrixBase<Q>& q, Out& M) const {
+    using T = typename Out::Scalar;
+    kernel<T>(q, M);
+    for (int i = 0; i < n_; ++i)
+      if (links_[std::size_t(i)].has_armature) M(i, i) += T(links_[std::size_t(i)].Ia);
+  }
+
   /// Written on plain scalars (detail::v3, detail::sym3), like the rne kernel: the joint
   /// angles in one batch, model constants (cos α, sin α, p, m, h, I_o) in the model's scalar.
   ///

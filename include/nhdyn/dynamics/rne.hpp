@@ -279,6 +279,24 @@ class rne_fn : public stage_tag {
     return v;
   }
 
+  /// v = rne(q, q̇, q̈) into v (n entries, of the model's and the inputs' promoted scalar; a
+  /// vector or a map: no allocation): the call's numbers and checks. v must not alias the
+  /// inputs (overwrite_qdd writes v over q̈).
+  template <class Q, class QD, class QDD, class V>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
+                Eigen::MatrixBase<V>& v) const {
+    static_assert(std::is_same_v<typename V::Scalar, promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>,
+                                                              typename QDD::Scalar>>,
+                  "v's scalar is the model's and the inputs' promoted scalar");
+    detail::check_size(q, n_, "q");
+    detail::check_size(qd, n_, "qd");
+    detail::check_size(qdd, n_, "qdd");
+    detail::check_size(v, n_, "v");
+    check_unseen(q, qd, qdd);
+    run(q, qd, qdd, v.derived());
+    detail::check_result(v, q, qd, qdd, "rne");
+  }
+
   /// With applied forces (external wrenches, dynamics/wrench.hpp): v − Q_ext(q).
   template <class Q, class QD, class QDD, applied_forces F>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,

@@ -342,9 +342,9 @@ class rne_derivatives_fn {
     return run(q, qd, qdd, &w.wrenches());
   }
 
-  /// Into a result whose matrices are reused: no allocation after the first call of a size, for
-  /// trees of up to 55 bodies (the scratch then lives on the stack: 32 KiB). `out` must not alias the
-  /// inputs.
+  /// Into a result whose matrices are reused: no allocation after the first call of a size, on
+  /// trees of any size (the scratch lives on the stack up to 55 bodies, 32 KiB; beyond, in a
+  /// heap block the thread keeps, detail/small_buffer.hpp). `out` must not alias the inputs.
   template <class Q, class QD, class QDD>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
                 rne_derivatives_result<S>& out) const {

@@ -37,7 +37,8 @@ void tree_rne_kernel_impl(const std::vector<tree_link<LS>>& L, const vec3<T>& g,
     mat3<T> R;
     vec3<T> w, dw, a, f, m;
   };
-  // on the stack up to 32 KiB of it (170 bodies in double), beyond on the heap; not zeroed
+  // on the stack up to 32 KiB of it (170 bodies in double), beyond in a heap block the thread
+  // keeps (detail/small_buffer.hpp); not zeroed
   small_buffer<ws, dynamic> s(n);
   const vec3<T> zero = vec3<T>::Zero();
   const vec3<T> a0 = Gravity ? vec3<T>(-g) : zero;
@@ -120,7 +121,8 @@ void tree_rne_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, cons
 template <class T, class Q, class Out>
 void tree_crba_kernel(const std::vector<tree_link<T>>& L, const Q& q, Out& H) {
   const int n = static_cast<int>(L.size());
-  // each body's placement and composite inertia, in one stack buffer (heap only beyond 32 KiB)
+  // each body's placement and composite inertia, in one stack buffer (beyond 32 KiB, a heap
+  // block the thread keeps)
   struct ws {
     mat3<T> R, Io;
     vec3<T> p, h;
