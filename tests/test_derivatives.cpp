@@ -58,6 +58,9 @@ void check_nh(const tree<double>& t, const C& c, std::mt19937_64& rng, const std
       r->work.se.setOnes(n + 1, m), r->work.st.nz.resize(3), r->work.st.singles.resize(2);
     }
     ef.ss.A.setOnes(3, 3), ef.ss.B.setOnes(4, 2), ef.eta_dot.setOnes(m + 5);
+    auto& x = ef.redundant;  // the p > m scratch, at other sizes too
+    x.Bq.setOnes(3, 3), x.Me.setOnes(2, 5), x.rhs_q.setOnes(1, 1), x.rhs_eta.setOnes(4, 4), x.dBy.setOnes(1, 7);
+    x.y.setOnes(9), x.unit.setOnes(2), x.Ecol.setOnes(1), x.qd.resize(2), x.yd.resize(5), x.e.resize(1), x.col.resize(6);
   }
   inverse_dynamics_derivatives(t, c).evaluate(VectorXd(2 * q), eta_dot, eta, e);
   forward_dynamics_derivatives(t, c).evaluate(VectorXd(2 * q), eta_dot, tau, ef);

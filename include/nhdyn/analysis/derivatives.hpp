@@ -538,8 +538,8 @@ struct fd_derivatives_result {
 /// rne_derivatives returns (refused, naming the model, when M is not positive definite).
 /// `evaluate(q, qd, tau [, w], out)` reuses out's matrices and scratch from call to call
 /// (inputs and wrenches in the model's scalar): no heap allocation once out has the tree's size,
-/// up to 51 bodies (the kernels' stack scratch; with wrenches, Q_ext and τ + Q_ext are new
-/// vectors).
+/// on trees of any size (the kernels' scratch beyond its stack part is a block the thread keeps,
+/// detail/small_buffer.hpp; with wrenches, Q_ext and τ + Q_ext are new vectors).
 template <class S>
 class fd_derivatives_fn {
  public:
@@ -642,6 +642,7 @@ struct nh_fd_derivatives_result {
   /// the forward dynamics' own result (η̇, S(q), M_η; run-time-sized constraints) and K's LU.
   nh_forward_dynamics_result<T, Eigen::Dynamic, M> fd;
   Eigen::PartialPivLU<Eigen::Matrix<T, M, M>> lu;
+  detail::redundant_eta_scratch<T> redundant;  ///< with more actuators than η (p > m)
 };
 
 /// A, B of a constrained tree's forward dynamics, analytically:
@@ -664,6 +665,7 @@ class nh_fd_derivatives_fn {
     finish(q, tau, ed, id_.constraint().S(q), out);
     out.id.work = {};
     out.lu = {};
+    out.redundant = {};
     return out;
   }
   template <class Q, class E, class TAU, class Kin, class W>
@@ -676,11 +678,13 @@ class nh_fd_derivatives_fn {
     finish(q, tau, ed, id_.constraint().S(q), out);
     out.id.work = {};
     out.lu = {};
+    out.redundant = {};
     return out;
   }
   /// Into a result whose storage is reused: no allocation once it has its sizes, where the
-  /// constraint is run-time sized and p = m (the redundant case, p > m, still forms S and SᵀE
-  /// anew). `out` must not alias the inputs; after an exception its contents are unspecified.
+  /// constraint is run-time sized, also with more actuators than η (p > m) where it writes E τ
+  /// and Sᵀ v into given storage (wheeled_base; detail::redundant_eta_rows). `out` must not
+  /// alias the inputs; after an exception its contents are unspecified.
   template <class Q, class E, class TAU>
     requires detail::in_scalar<S, Q, E, TAU>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
@@ -736,8 +740,8 @@ class nh_fd_derivatives_fn {
       out.lu.matrixLU().template triangularView<Eigen::UnitLower>().solveInPlace(k_inv);
       out.lu.matrixLU().template triangularView<Eigen::Upper>().solveInPlace(k_inv);
     } else {  // more actuators than η (linearize.hpp, detail::redundant_eta_rows)
-      detail::redundant_eta_rows(id_.constraint(), vecN<T, dynamic>(q.template cast<T>()), J.dq, J.deta, J.deta_dot, tau,
-                                 J.tau, out.ss.A, out.ss.B);
+      detail::redundant_eta_rows(id_.constraint(), q, s, J.dq, J.deta, J.deta_dot, tau, J.tau, out.ss.A, out.ss.B,
+                                 out.redundant);
     }
   }
 

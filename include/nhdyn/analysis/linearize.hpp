@@ -324,29 +324,69 @@ namespace detail {
 ///     ∂η̇/∂x = M_η⁻¹ ((∂B/∂x)(τ − τ_id) − B ∂τ_id/∂x),   ∂η̇/∂τ = M_η⁻¹ B,
 ///
 /// (∂B/∂q)y by duals of q ↦ Sᵀ(q)E(q)y along the joints the constraint depends on. Writes the
-/// bottom m rows of A ((n+m) × (n+m)) and B ((n+m) × p).
-template <class C, class T, class JQ, class JE, class JD, class Tau, class TauId, class AA, class BB>
-void redundant_eta_rows(const C& c, const vecN<T, dynamic>& q, const JQ& Jq, const JE& Je, const JD& Jd, const Tau& tau,
-                        const TauId& tau_id, AA& A, BB& B) {
-  using Mat = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>;
-  const int n = c.dof(), m = c.m();
-  const Mat Bq = (c.S(q).transpose() * input_map(c, q)).template cast<T>();
-  const Mat Me = Bq * Jd;
-  const Eigen::PartialPivLU<Mat> lu(Me);
-  const vecN<T, dynamic> y = (tau.template cast<T>() - tau_id.template cast<T>()).eval();
-  Mat dBy = Mat::Zero(m, n);
+/// bottom m rows of A ((n+m) × (n+m)) and B ((n+m) × p); `s` is S(q) (n × m). Every matrix and
+/// vector it forms lives in `ws` (redundant_eta_scratch), so that a call into a reused scratch
+/// allocates nothing where the constraint writes E τ and Sᵀ v into given storage
+/// (E_times_into, St_times_into: wheeled_base); other constraints form E(q) and Sᵀ v anew.
+template <class T>
+struct redundant_eta_scratch {
+  using matrix_type = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>;
+  matrix_type Bq, Me, rhs_q, rhs_eta, dBy;  ///< SᵀE, SᵀE K, (∂B/∂q)y − B ∂τ_id/∂q, B ∂τ_id/∂η, (∂B/∂q)y
+  Eigen::PartialPivLU<matrix_type> lu;      ///< of M_η = SᵀE K
+  vecN<T, dynamic> y, unit, Ecol;           ///< τ − τ_id; e_a and E e_a (SᵀE's columns)
+  vecN<dual<T, 1>, dynamic> qd, yd, e, col;  ///< q + ε e_j, y, E y and Sᵀ E y in duals
+};
+
+template <class C, class Q, class Sq, class JQ, class JE, class JD, class Tau, class TauId, class AA, class BB, class T>
+void redundant_eta_rows(const C& c, const Q& q, const Sq& s, const JQ& Jq, const JE& Je, const JD& Jd, const Tau& tau,
+                        const TauId& tau_id, AA& A, BB& B, redundant_eta_scratch<T>& ws) {
   using D = dual<T, 1>;
+  using V = vecN<T, dynamic>;
+  using VD = vecN<D, dynamic>;
+  const int n = c.dof(), m = c.m(), p = actuator_count(c);
+  // B = SᵀE, column by column from E's columns where E is applied in place
+  ws.Bq.resize(m, p);
+  if constexpr (has_E_times_into<C, Q, V, V>) {
+    ws.unit.setZero(p);
+    ws.Ecol.resize(n);
+    for (int a = 0; a < p; ++a) {
+      ws.unit(a) = T(1);
+      c.E_times_into(q, ws.unit, ws.Ecol);
+      ws.unit(a) = T(0);
+      ws.Bq.col(a).noalias() = s.transpose().template cast<T>() * ws.Ecol;
+    }
+  } else {  // in T, as the inputs' promoted scalar forms it
+    ws.Bq = s.transpose().template cast<T>() * input_map(c, q.template cast<T>()).template cast<T>();
+  }
+  ws.Me.noalias() = ws.Bq * Jd;
+  ws.lu.compute(ws.Me);
+  ws.y = tau.template cast<T>() - tau_id.template cast<T>();
+  ws.dBy.setZero(m, n);
+  ws.qd = q.template cast<T>().template cast<D>();
+  ws.yd = ws.y.template cast<D>();
+  ws.e.resize(n);
+  ws.col.resize(m);
   for (int j = 0; j < n; ++j) {
     if (!constraint_depends_on(c, j)) continue;
-    vecN<D, dynamic> qd = q.template cast<D>();
-    qd(j).derivative(0) = T(1);
-    const vecN<D, dynamic> e = (input_map(c, qd) * y.template cast<D>()).eval();
-    const auto col = apply_St(c, qd, e);
-    for (int i = 0; i < m; ++i) dBy(i, j) = col(i).derivative(0);
+    ws.qd(j).derivative(0) = T(1);
+    if constexpr (has_E_times_into<C, VD, VD, VD>)
+      c.E_times_into(ws.qd, ws.yd, ws.e);
+    else
+      ws.e = input_map(c, ws.qd) * ws.yd;
+    apply_St_into(c, ws.qd, ws.e, ws.col);
+    ws.qd(j).derivative(0) = T(0);
+    for (int i = 0; i < m; ++i) ws.dBy(i, j) = ws.col(i).derivative(0);
   }
-  A.block(n, 0, m, n) = lu.solve(Mat(dBy - Bq * Jq));
-  A.block(n, n, m, m) = -lu.solve(Mat(Bq * Je));
-  B.bottomRows(m) = lu.solve(Bq);
+  ws.rhs_q = ws.dBy;
+  ws.rhs_q.noalias() -= ws.Bq * Jq;
+  ws.rhs_eta.noalias() = ws.Bq * Je;
+  // each solved into its block, then negated there (no temporaries)
+  auto a_q = A.block(n, 0, m, n);
+  auto a_eta = A.block(n, n, m, m);
+  a_q = ws.lu.solve(ws.rhs_q);
+  a_eta = ws.lu.solve(ws.rhs_eta);
+  a_eta = -a_eta;
+  B.bottomRows(m) = ws.lu.solve(ws.Bq);
 }
 }  // namespace detail
 
@@ -424,7 +464,8 @@ class forward_dynamics_linearizer {
       out.B.bottomRows(m) = K.inverse();
     } else {
       const vecN<T, dynamic> tau_id = id_tau_(qt, et, eta_dot);
-      detail::redundant_eta_rows(c_, vecN<T, dynamic>(qt), J.dq(), J.deta(), J.deta_dot(), tau, tau_id, out.A, out.B);
+      detail::redundant_eta_scratch<T> ws;
+      detail::redundant_eta_rows(c_, qt, c_.S(qt), J.dq(), J.deta(), J.deta_dot(), tau, tau_id, out.A, out.B, ws);
     }
     return out;
   }

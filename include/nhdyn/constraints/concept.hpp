@@ -63,6 +63,9 @@ concept has_S_into = requires(const C& c, const Q& q, Mat& s) { c.S_into(q, s); 
 /// Optional: Sᵀ v without forming S.
 template <class C, class Q, class V>
 concept has_St_times = requires(const C& c, const Q& q, const V& v) { c.St_times(q, v); };
+/// Optional: Sᵀ v into given storage (m entries) without forming S or a new vector.
+template <class C, class Q, class V, class Out>
+concept has_St_times_into = requires(const C& c, const Q& q, const V& v, Out& out) { c.St_times_into(q, v, out); };
 /// Optional: E τ into given storage (n entries) without forming E (wheeled_base: τ at the
 /// actuated joints, zeros elsewhere).
 template <class C, class Q, class Tau, class Out>
@@ -260,6 +263,16 @@ auto apply_St(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase
     return c.St_times(q, v);
   else
     return vecN<promote_t<typename Q::Scalar, typename V::Scalar>, C::m_at_compile_time>(c.S(q).transpose() * v);
+}
+/// Sᵀ v into out (m entries; a vector or a map): without allocation where the constraint has
+/// St_times_into and out has the scalar apply_St would return, else through apply_St.
+template <class C, class Q, class V, class Out>
+void apply_St_into(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v, Eigen::MatrixBase<Out>& out) {
+  using R = typename decltype(apply_St(c, q, v))::Scalar;
+  if constexpr (has_St_times_into<C, Q, V, Out> && std::is_same_v<typename Out::Scalar, R>)
+    c.St_times_into(q, v, out);
+  else
+    out = apply_St(c, q, v);
 }
 template <class C, class Q, class QD, class E>
 auto apply_Sdot(const C& c, const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,

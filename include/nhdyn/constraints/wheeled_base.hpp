@@ -440,11 +440,20 @@ class wheeled_base {
   template <class Q, class V>
   auto St_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
     using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename V::Scalar>;
-    check_q(q);
-    const factored<T> f(*this, q, true);
     vecN<T, dynamic> out(m());
-    project_force(f.sd.data(), v, out);
+    St_times_into(q, v, out);
     return out;
+  }
+  /// The same into out (m entries, of the promoted scalar of the model, q and v): no
+  /// allocation (`has_St_times_into`).
+  template <class Q, class V, class Out>
+  void St_times_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v, Eigen::MatrixBase<Out>& out) const {
+    using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename V::Scalar>;
+    static_assert(std::is_same_v<typename Out::Scalar, T>, "out's scalar is the model's, q's and v's promoted scalar");
+    check_q(q);
+    detail::check_size(out, m(), "S^T v");
+    const factored<T> f(*this, q, true);
+    project_force(f.sd.data(), v, out);
   }
 
   /// What the lift leaves for the projection (carried through rne with (q, v)): S's dependent
