@@ -12,8 +12,10 @@
 ///   crba/<tree>/{nhdyn, reference}               spatial-algebra reference, KDL's tree solver);
 ///   {rne, crba, aba}/<tree>/evaluate            the kernels into a result the caller reuses;
 ///   aba/<tree>/nhdyn                            ABA on the tree (a returned q̈)
-///   fd/<model>/{aba, aba_reference, crba_ldlt, kdl}  holonomic forward dynamics: the articulated-
-///                                               body algorithm (kernel, reference), CRBA + LDLᵀ, KDL
+///   fd/<model>/{aba, aba_reference, crba_ldlt, crba_ldlt_evaluate, kdl}  holonomic forward
+///                                               dynamics: the articulated-body algorithm (kernel,
+///                                               reference), CRBA + LDLᵀ (a call; into a reused
+///                                               q̈ and scratch), KDL
 ///                                               mass matrix by the kernel and the reference
 ///   nh_id/<robot>/{rne, evaluate, lagrange}     a robot file's nonholonomic inverse dynamics (evaluate: into a reused τ)
 ///   nh_pair/<robot>/{run_time, evaluate}         (robot: mobile_manipulator_{ddrive, wheels,
@@ -204,6 +206,17 @@ void register_fd(const std::string& model, const chain<double>& cd) {
     auto r = cr(s.q, s.qd, tau);
     benchmark::DoNotOptimize(r);
   });
+  {  // the same into a reused q̈ and scratch (M, h, M's factor)
+    nhdyn::forward_dynamics_scratch<double, nhdyn::dynamic> ws;
+    Eigen::VectorXd out;
+    cr.evaluate(s.q, s.qd, tau, ws, out);
+    agree(out, qdd, 0, "fd/" + model + ": crba_ldlt evaluate vs the call");
+    add("fd/" + model + "/crba_ldlt_evaluate", [cr, s, tau, ws, out]() mutable {
+      opaque(s.q), opaque(s.qd), opaque(tau);
+      cr.evaluate(s.q, s.qd, tau, ws, out);
+      benchmark::DoNotOptimize(out.data());
+    });
+  }
   add("fd/" + model + "/kdl", [k]() { benchmark::DoNotOptimize(kdl::run_fd(k.get())); });
 }
 
@@ -919,7 +932,8 @@ int main(int argc, char** argv) {
 #endif
   std::mt19937_64 tree_rng(41);
   std::vector<std::pair<std::string, nhdyn::tree<double>>> trees;
-  for (int n : {12, 24, 48})  // branching trees, URDF-like (no body offsets)
+  // branching trees, URDF-like (no body offsets); 96 bodies: past the kernels' stack scratch
+  for (int n : {12, 24, 48, 96})
     trees.emplace_back("tree" + std::to_string(n), nhdyn_ref::random_tree(tree_rng, n, 0.4, false));
   for (const auto& [name, t] : trees) register_tree(name, t);
 
@@ -938,7 +952,8 @@ int main(int argc, char** argv) {
 #ifdef NHDYN_BENCH_URDF
   register_batch("mobile_manipulator", nhdyn::io::load_urdf(NHDYN_SOURCE_DIR "/examples/urdf/mobile_manipulator.urdf"));
 #endif
-  for (const auto& [name, t] : trees) register_batch(name, t);
+  for (const auto& [name, t] : trees)
+    if (t.dof() <= 48) register_batch(name, t);
   benchmark::AddCustomContext("simd_width", std::to_string(nhdyn::simd_width));
 
   benchmark::AddCustomContext("nhdyn_compiler", NHDYN_BENCH_CXX);
