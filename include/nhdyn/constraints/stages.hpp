@@ -347,8 +347,8 @@ auto nh_tree_pipeline(const tree<S>& t, const C& c, rne_options o, Out out) {
 /// inverse_dynamics on a tree (constraint run-time sized): the composition project ∘ rne ∘
 /// lift itself (it derives from it: every call form it has, the same numbers), and
 /// `evaluate(q, η, η̇, τ)`, the same three stages into storage: lift.into writes ξ's q̇ and q̈
-/// into stack scratch (beyond 256 joints, a heap block the thread keeps), rne.evaluate writes v over q̈, project.into
-/// writes τ into the caller's vector. No allocation where the constraint lifts and projects
+/// into stack scratch (beyond 256 joints, a heap block the thread keeps), rne.evaluate writes
+/// v over q̈, project.into writes τ into the caller's vector. No allocation where the constraint lifts and projects
 /// into given storage (every built-in base constraint; wheeled_base with k·|η ∩ W| ≤ 24).
 template <class Composed, class C>
 struct tree_inverse_dynamics : Composed {

@@ -269,13 +269,8 @@ class rne_fn : public stage_tag {
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
                   const Eigen::MatrixBase<QDD>& qdd) const {
     using T = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>, typename QDD::Scalar>;
-    detail::check_size(q, n_, "q");
-    detail::check_size(qd, n_, "qd");
-    detail::check_size(qdd, n_, "qdd");
-    check_unseen(q, qd, qdd);
     vecN<T, N> v(n_);
-    run(q, qd, qdd, v);
-    detail::check_result(v, q, qd, qdd, "rne");
+    evaluate(q, qd, qdd, v);
     return v;
   }
 
