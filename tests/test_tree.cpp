@@ -179,6 +179,36 @@ TEST_CASE("tree kernels equal the reference for float, duals and intervals", "[t
       CHECK(v(i).upper() - v(i).lower() < 1e-9 * std::max(1.0, std::abs(ref(i))));
     }
   }
+  SECTION("intervals: the CRBA encloses M at the point and at samples of a box of q") {
+    const tree<interval> ti = t.cast<interval>();
+    const MatrixXd H = reference::crba<double>(t, q);
+    const double scale = 1 + H.cwiseAbs().maxCoeff();
+    const auto Mp = mass_matrix(ti)(q.cast<interval>());
+    Eigen::Matrix<interval, Eigen::Dynamic, 1> qb(n);
+    for (int i = 0; i < n; ++i) qb(i) = interval(q(i) - 1e-3, q(i) + 1e-3);
+    const auto Mb = mass_matrix(ti)(qb);
+    double widest = 0;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        CHECK(Mp(i, j).lower() <= H(i, j) + 1e-12 * scale);
+        CHECK(Mp(i, j).upper() >= H(i, j) - 1e-12 * scale);
+        CHECK(Mp(i, j).width() < 1e-9 * scale);
+        widest = std::max(widest, Mb(i, j).width());
+      }
+    // the box's M over-encloses (about 7× the samples' range here) but stays of the box's order
+    CHECK(widest < 0.02 * scale);
+    std::uniform_real_distribution<double> u(-1e-3, 1e-3);
+    for (int s = 0; s < 50; ++s) {
+      VectorXd qs = q;
+      for (int i = 0; i < n; ++i) qs(i) += u(rng);
+      const MatrixXd Hs = reference::crba<double>(t, qs);
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          CHECK(Mb(i, j).lower() <= Hs(i, j) + 1e-12 * scale);
+          CHECK(Mb(i, j).upper() >= Hs(i, j) - 1e-12 * scale);
+        }
+    }
+  }
 }
 
 TEST_CASE("tree dynamics: M q̈ + h = rne, forward dynamics inverts it, gravity and power balance", "[tree]") {

@@ -11,7 +11,8 @@
 /// joint's motion is then Rz(q) or Tz(q), the joint subspace is a unit vector, and every
 /// constant (placement of K_i in K_λ(i), m, m·c, the rotational inertia about K_i's origin) is
 /// computed once when the function object is built. Velocities and forces are 3-vectors in
-/// those frames (the Luh–Walker–Paul form of the same recursion).
+/// those frames (the Luh–Walker–Paul form of the same recursion); the CRBA builds its
+/// composites in them too, and reads M off in world axes (see tree_crba_kernel_impl).
 #include <Eigen/Core>
 #include <vector>
 
@@ -127,16 +128,18 @@ void tree_rne_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, cons
 ///    v = z: f = m z, n = h × z), turned to world axes once; then for each ancestor j, the
 ///    moment about j's origin n + d × f, with d = Σ w_k from i up to j (accumulated step by step,
 ///    so the positions stay as local as the frames': no far reference point), and
-///    H(i, j) = z_j · (n + d × f) for a revolute j, z_j · f for a prismatic one. Three products per
-///    step instead of carrying (n, f) through each parent frame (two rotations and a cross);
+///    H(i, j) = z_j · (n + d × f) for a revolute j, z_j · f for a prismatic one: a cross and a dot
+///    per step (9 multiplications) instead of carrying (n, f) through each parent frame (two
+///    rotations and a cross: 24);
 ///  - then the composite goes to the parent's frame: h' = R h + m p, and, with a = R h + (m/2) p,
 ///    I_o' = R I_o Rᵀ + 2 (p·a) 1 − (a pᵀ + p aᵀ) (the parallel-axis theorem), the symmetric
-///    product written as its six entries.
+///    product written as its six entries; on the diagonal 2 (p·a) − 2 a_k p_k is summed as the
+///    two other terms (no cancellation, and no widening for intervals).
 template <class T, class Q, class Out>
 void tree_crba_kernel_impl(const std::vector<tree_link<T>>& L, const Q& q, Out& H) {
   const int n = static_cast<int>(L.size());
-  // on the stack up to 32 KiB (about 100 bodies in double), beyond in a heap block the thread
-  // keeps (detail/small_buffer.hpp)
+  // on the stack up to 32 KiB (110 bodies in double), beyond in a heap block the thread keeps
+  // (detail/small_buffer.hpp)
   struct ws {
     mat3<T> R, Io, W;
     vec3<T> p, h, w;
@@ -187,11 +190,10 @@ void tree_crba_kernel_impl(const std::vector<tree_link<T>>& L, const Q& q, Out& 
     const auto& p = c.p;
     const vec3<T> hr = R * c.h;
     const vec3<T> a = hr + (T(0.5) * c.m) * p;
-    const T pa2 = T(2) * p.dot(a);
     const mat3<T> C = R * c.Io;  // R I_o Rᵀ (r, k) = C.row(r) · R.row(k)
-    const T i00 = C.row(0).dot(R.row(0)) + pa2 - T(2) * a(0) * p(0);
-    const T i11 = C.row(1).dot(R.row(1)) + pa2 - T(2) * a(1) * p(1);
-    const T i22 = C.row(2).dot(R.row(2)) + pa2 - T(2) * a(2) * p(2);
+    const T i00 = C.row(0).dot(R.row(0)) + T(2) * (p(1) * a(1) + p(2) * a(2));
+    const T i11 = C.row(1).dot(R.row(1)) + T(2) * (p(0) * a(0) + p(2) * a(2));
+    const T i22 = C.row(2).dot(R.row(2)) + T(2) * (p(0) * a(0) + p(1) * a(1));
     const T i01 = C.row(0).dot(R.row(1)) - a(0) * p(1) - p(0) * a(1);
     const T i02 = C.row(0).dot(R.row(2)) - a(0) * p(2) - p(0) * a(2);
     const T i12 = C.row(1).dot(R.row(2)) - a(1) * p(2) - p(1) * a(2);
