@@ -11,6 +11,7 @@
 ///   rne/<tree>/{nhdyn, reference, kdl}          rne on kinematic trees (the kernel, the plain
 ///   crba/<tree>/{nhdyn, reference}               spatial-algebra reference, KDL's tree solver);
 ///   {rne, crba, aba}/<tree>/evaluate            the kernels into a result the caller reuses;
+///   crba_pair/<tree>                             rne and CRBA evaluate paired (ratio CRBA / rne);
 ///   aba/<tree>/nhdyn                            ABA on the tree (a returned q̈)
 ///   fd/<model>/{aba, aba_reference, crba_ldlt, crba_ldlt_evaluate, kdl}  holonomic forward
 ///                                               dynamics: the articulated-body algorithm (kernel,
@@ -447,6 +448,20 @@ void register_tree(const std::string& model, const nhdyn::tree<double>& t) {
       M.evaluate(s.q, Hm);
       benchmark::DoNotOptimize(Hm.data());
     });
+    // crba_pair/<tree>: one rne and one CRBA of the same tree and state, both into reused
+    // storage, paired (ratio = CRBA / rne; issue 33's target ≤ 0.6)
+    add_paired(
+        "crba_pair/" + model,
+        [id, s, v]() mutable {
+          opaque(s.q), opaque(s.qd), opaque(s.qdd);
+          id.evaluate(s.q, s.qd, s.qdd, v);
+          benchmark::DoNotOptimize(v.data());
+        },
+        [M, s, Hm]() mutable {
+          opaque(s.q);
+          M.evaluate(s.q, Hm);
+          benchmark::DoNotOptimize(Hm.data());
+        });
     // ABA (q̈ for τ = rne(q, q̇, q̈) gives q̈ back), as a call and into a reused q̈
     const auto fd = nhdyn::aba(t);
     agree(fd(s.q, s.qd, tau), s.qdd, 1e-8, "aba/" + model + ": aba inverts rne");
@@ -908,6 +923,10 @@ int main(int argc, char** argv) {
 
 #ifdef NHDYN_BENCH_URDF
   register_tree("mobile_manipulator", nhdyn::io::load_urdf(NHDYN_SOURCE_DIR "/examples/urdf/mobile_manipulator.urdf"));
+  // the project's TIAGo-style (56 joints, a five-finger hand) and PR2-style (four driven castors
+  // and an arm) files, as trees
+  register_tree("tiago_style", nhdyn::io::load_urdf(NHDYN_SOURCE_DIR "/examples/urdf/tiago_style.urdf"));
+  register_tree("powered_castors_arm", nhdyn::io::load_urdf(NHDYN_SOURCE_DIR "/examples/urdf/powered_castors_arm.urdf"));
   for (const auto& [name, file] : {std::pair{"mobile_manipulator_ddrive", "mobile_manipulator.json"},
                                    std::pair{"mobile_manipulator_wheels", "mobile_manipulator_wheels.json"},
                                    std::pair{"mobile_manipulator_bicycle", "mobile_manipulator_bicycle.json"},
