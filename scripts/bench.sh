@@ -54,6 +54,14 @@ json="$root/docs/performance.json"
   --benchmark_out="$json" --benchmark_out_format=json
 echo "bench.sh: wrote $json"
 [ $docs -eq 0 ] && exit 0
+# clang: the g++ build's run of the same cases right after it (the two-compiler table's g++
+# column: the same sitting, as the machine's speed drifts from hour to hour)
+if [ "$clang" = 1 ] && [ -x "$root/build-bench/bench/nhdyn_bench" ]; then
+  "$root/build-bench/bench/nhdyn_bench" --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true \
+    --benchmark_report_aggregates_only=true --benchmark_min_time="$min_time" --benchmark_filter="$filter" \
+    --benchmark_out="$root/docs/performance-clang-gcc.json" --benchmark_out_format=json
+  echo "bench.sh: wrote $root/docs/performance-clang-gcc.json"
+fi
 
 cpu="$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -1)"
 compiler_of() { "$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$1/CMakeCache.txt")" --version | head -1; }
@@ -64,6 +72,7 @@ main_json="$root/docs/performance.json" clang_json="$root/docs/performance-clang
 compiler="$(compiler_of "$main_build")"
 second=()
 [ -f "$clang_json" ] && [ -f "$clang_build/CMakeCache.txt" ] && second=(--second "$clang_json" --second-compiler "$(compiler_of "$clang_build")")
+[ ${#second[@]} -gt 0 ] && [ -f "$root/docs/performance-clang-gcc.json" ] && second+=(--second-baseline "$root/docs/performance-clang-gcc.json")
 "$py" "$root/scripts/perf_table.py" "$main_json" "$root/docs/performance.md" "$root/docs/performance_scaling.png" \
   --cpu "$cpu" --compiler "$compiler" "${second[@]}"
 [ "$clang" = 1 ] && exit 0

@@ -520,11 +520,17 @@ TARGET_CLANG = 1.1
 CLANG_FILTER = "^(" + "|".join(re.escape(n) for _, _, n in TWO_COMPILERS) + ")$"
 
 
-def two_compilers(med, second_med, second_compiler, first_compiler, rerun=frozenset()):
+def two_compilers(med, second_med, second_compiler, first_compiler, rerun=frozenset(), baseline=None):
     out = ["### Two compilers: the same kernels built by clang (issue 33)\n"]
-    out.append(f"The benchmarks below from a second build of `nhdyn_bench` by {second_compiler} (same flags, "
-               f"`NHDYN_BENCH_CLANG=1 scripts/bench.sh`: `build-bench-clang/`, docs/performance-clang.json), beside "
-               f"this page's build by {first_compiler}; medians, ns per call, each build's own run.\n")
+    if baseline:
+        out.append(f"The benchmarks below from a second build of `nhdyn_bench` by {second_compiler} (same flags, "
+                   f"`NHDYN_BENCH_CLANG=1 scripts/bench.sh`: `build-bench-clang/`, docs/performance-clang.json), "
+                   f"and this page's build by {first_compiler} run on the same cases right after it "
+                   f"(docs/performance-clang-gcc.json, {baseline}); medians, ns per call.\n")
+    else:
+        out.append(f"The benchmarks below from a second build of `nhdyn_bench` by {second_compiler} (same flags, "
+                   f"`NHDYN_BENCH_CLANG=1 scripts/bench.sh`: `build-bench-clang/`, docs/performance-clang.json), beside "
+                   f"this page's build by {first_compiler}; medians, ns per call, each build's own run.\n")
     out.append("| kernel | model | g++ | clang | clang / g++ |")
     out.append("|---|---|---:|---:|---:|")
     worst, later = 0.0, False
@@ -558,6 +564,8 @@ def main():
     ap.add_argument("--compiler", default="unknown compiler")
     ap.add_argument("--second", help="a second build's JSON (clang): the two-compiler table")
     ap.add_argument("--second-compiler", default="clang")
+    ap.add_argument("--second-baseline", help="the first compiler's run of the second's cases in the same sitting "
+                                              "(the two-compiler table's g++ column)")
     ap.add_argument("--print-clang-filter", action="store_true", help="print the second run's benchmark filter")
     if "--print-clang-filter" in sys.argv:
         print(CLANG_FILTER)
@@ -567,6 +575,11 @@ def main():
     text = tables(ctx, med, allocs, reps, a.cpu, a.compiler)
     if a.second:  # (after tables(): the second file's paired ratios, if any, do not reach them)
         second_ctx, second_med, _, _ = load(a.second)
+    if a.second and a.second_baseline:
+        base_ctx, base_med, _, _ = load(a.second_baseline)
+        text += two_compilers(base_med, second_med, a.second_compiler, a.compiler,
+                              baseline=f"{base_ctx['date']}; clang: {second_ctx['date']}")
+    elif a.second:
         # each g++ median's run: the last filtered re-run that holds it, else the full run; a ratio
         # is drawn only where that run and the clang run are within 12 hours of each other
         when = {}
