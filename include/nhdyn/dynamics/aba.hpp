@@ -151,23 +151,32 @@ void tree_aba_kernel_impl(const std::vector<tree_link<LS>>& L, const vec3<T>& g,
     const vec3<T> z = b.R.col(2);
     const T qdi = T(qd(i));
     if (k.revolute) {  // v_J = (z q̇, 0): c = v × v_J = (ω × z q̇, v_O × z q̇)
-      b.c << w.cross(z) * qdi, vo.cross(z) * qdi;
+      b.c.template head<3>() = w.cross(z) * qdi;
+      b.c.template tail<3>() = vo.cross(z) * qdi;
       w += z * qdi;
     } else {  // v_J = (0, z q̇): c = (0, ω × z q̇)
-      b.c << vec3<T>::Zero(), w.cross(z) * qdi;
+      b.c.template head<3>().setZero();
+      b.c.template tail<3>() = w.cross(z) * qdi;
       vo += z * qdi;
     }
-    b.v << w, vo;
+    // (fixed-size blocks, not comma initialisers: those assign through run-time-sized blocks,
+    // which clang 14 leaves as out-of-line loops even in a flattened kernel)
+    b.v.template head<3>() = w;
+    b.v.template tail<3>() = vo;
     // the rigid-body inertia in world axes about K_i's origin: R I_o Rᵀ, h = R h_K, m
     const vec3<T> h = b.R * k.h;
     mat3<T> IoRt, Io;
     IoRt.noalias() = k.Io * b.R.transpose();
     Io.noalias() = b.R * IoRt;
     const mat3<T> H = spatial::skew(h);
-    b.IA << Io, H, -H, k.m * mat3<T>::Identity();
+    b.IA.template topLeftCorner<3, 3>() = Io;
+    b.IA.template topRightCorner<3, 3>() = H;
+    b.IA.template bottomLeftCorner<3, 3>() = -H;
+    b.IA.template bottomRightCorner<3, 3>() = k.m * mat3<T>::Identity();
     // (7.35): p = v ×* I v, with I v = (I_o ω + h × v_O, m v_O − h × ω)
     const vec3<T> fn = Io * w + h.cross(vo), ff = k.m * vo - h.cross(w);
-    b.pA << w.cross(fn) + vo.cross(ff), w.cross(ff);
+    b.pA.template head<3>() = w.cross(fn) + vo.cross(ff);
+    b.pA.template tail<3>() = w.cross(ff);
   }
   for (int i = n - 1; i >= 0; --i) {  // pass 2: articulated inertias and bias forces, leaves to root
     const tree_link<LS>& k = L[i];
@@ -195,10 +204,12 @@ void tree_aba_kernel_impl(const std::vector<tree_link<LS>>& L, const vec3<T>& g,
     const tree_link<LS>& k = L[i];
     aba_scratch<T>& b = s[i];
     if (k.parent < 0) {  // a_0 = −a_g
-      b.a << vec3<T>::Zero(), -g;
+      b.a.template head<3>().setZero();
+      b.a.template tail<3>() = -g;
     } else {  // (7.42): a_λ moved to K_i's origin
       const aba_scratch<T>& l = s[k.parent];
-      b.a << l.a.template head<3>(), l.a.template tail<3>() + vec3<T>(l.a.template head<3>()).cross(b.d);
+      b.a.template head<3>() = l.a.template head<3>();
+      b.a.template tail<3>() = l.a.template tail<3>() + vec3<T>(l.a.template head<3>()).cross(b.d);
     }
     b.a += b.c;
     const vec3<T> z = b.R.col(2);
