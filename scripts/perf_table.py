@@ -522,15 +522,12 @@ CLANG_FILTER = "^(" + "|".join(re.escape(n) for _, _, n in TWO_COMPILERS) + ")$"
 
 def two_compilers(med, second_med, second_compiler, first_compiler, rerun=frozenset(), baseline=None):
     out = ["### Two compilers: the same kernels built by clang (issue 33)\n"]
-    if baseline:
-        out.append(f"The benchmarks below from a second build of `nhdyn_bench` by {second_compiler} (same flags, "
-                   f"`NHDYN_BENCH_CLANG=1 scripts/bench.sh`: `build-bench-clang/`, docs/performance-clang.json), "
-                   f"and this page's build by {first_compiler} run on the same cases right after it "
-                   f"(docs/performance-clang-gcc.json, {baseline}); medians, ns per call.\n")
-    else:
-        out.append(f"The benchmarks below from a second build of `nhdyn_bench` by {second_compiler} (same flags, "
-                   f"`NHDYN_BENCH_CLANG=1 scripts/bench.sh`: `build-bench-clang/`, docs/performance-clang.json), beside "
-                   f"this page's build by {first_compiler}; medians, ns per call, each build's own run.\n")
+    first = (f"and this page's build by {first_compiler} run on the same cases right after it "
+             f"(docs/performance-clang-gcc.json, {baseline}); medians, ns per call." if baseline else
+             f"beside this page's build by {first_compiler}; medians, ns per call, each build's own run.")
+    out.append(f"The benchmarks below from a second build of `nhdyn_bench` by {second_compiler} (same flags, "
+               f"`NHDYN_BENCH_CLANG=1 scripts/bench.sh`: `build-bench-clang/`, docs/performance-clang.json), "
+               f"{first}\n")
     out.append("| kernel | model | g++ | clang | clang / g++ |")
     out.append("|---|---|---:|---:|---:|")
     worst, later = 0.0, False
@@ -573,13 +570,13 @@ def main():
     a = ap.parse_args()
     ctx, med, allocs, reps = load(a.json)
     text = tables(ctx, med, allocs, reps, a.cpu, a.compiler)
-    if a.second:  # (after tables(): the second file's paired ratios, if any, do not reach them)
+    if a.second and a.second_baseline:  # (after tables(): the paired ratios of these files do not reach them)
         second_ctx, second_med, _, _ = load(a.second)
-    if a.second and a.second_baseline:
         base_ctx, base_med, _, _ = load(a.second_baseline)
         text += two_compilers(base_med, second_med, a.second_compiler, a.compiler,
                               baseline=f"{base_ctx['date']}; clang: {second_ctx['date']}")
     elif a.second:
+        second_ctx, second_med, _, _ = load(a.second)
         # each g++ median's run: the last filtered re-run that holds it, else the full run; a ratio
         # is drawn only where that run and the clang run are within 12 hours of each other
         when = {}

@@ -150,6 +150,8 @@ void tree_aba_kernel_impl(const std::vector<tree_link<LS>>& L, const vec3<T>& g,
     }
     const vec3<T> z = b.R.col(2);
     const T qdi = T(qd(i));
+    // (fixed-size blocks, not comma initialisers: those assign through run-time-sized blocks,
+    // which clang 14 leaves as out-of-line loops even in a flattened kernel)
     if (k.revolute) {  // v_J = (z q̇, 0): c = v × v_J = (ω × z q̇, v_O × z q̇)
       b.c.template head<3>() = w.cross(z) * qdi;
       b.c.template tail<3>() = vo.cross(z) * qdi;
@@ -159,8 +161,6 @@ void tree_aba_kernel_impl(const std::vector<tree_link<LS>>& L, const vec3<T>& g,
       b.c.template tail<3>() = w.cross(z) * qdi;
       vo += z * qdi;
     }
-    // (fixed-size blocks, not comma initialisers: those assign through run-time-sized blocks,
-    // which clang 14 leaves as out-of-line loops even in a flattened kernel)
     b.v.template head<3>() = w;
     b.v.template tail<3>() = vo;
     // the rigid-body inertia in world axes about K_i's origin: R I_o Rᵀ, h = R h_K, m
