@@ -10,3 +10,13 @@
 #else
 #define NHDYN_FLATTEN
 #endif
+
+/// Inline this small helper into every kernel that calls it (GCC, Clang). Clang 14's flatten
+/// inlines only the calls written in the flattened function itself, not the calls of the
+/// functions it inlines: a kernel's per-body helper (kernel_placement, add_shifted_inertia) was
+/// left as a call in every body's step. Off with NHDYN_NO_FLATTEN, as flatten is.
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(NHDYN_NO_FLATTEN)
+#define NHDYN_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define NHDYN_ALWAYS_INLINE inline
+#endif

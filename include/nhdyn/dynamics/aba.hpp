@@ -103,7 +103,7 @@ struct aba_scratch {
 /// I += the articulated inertia J (world axes, about a point d from I's point) moved to I's
 /// point: with P = d×, A += A_J − B_J P − (B_J P)ᵀ − P C_J P, B += B_J − (C_J P)ᵀ, C += C_J.
 template <class T>
-void add_shifted_inertia(spatial::mat6<T>& I, const spatial::mat6<T>& J, const vec3<T>& d) {
+NHDYN_ALWAYS_INLINE void add_shifted_inertia(spatial::mat6<T>& I, const spatial::mat6<T>& J, const vec3<T>& d) {
   mat3<T> BP, CP;  // row j of M P is (M.row(j)ᵀ × d)ᵀ
   for (int j = 0; j < 3; ++j) {
     BP.row(j) = vec3<T>(J.template block<1, 3>(j, 3).transpose()).cross(d).transpose();

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "../detail/attributes.hpp"
 #include "dh_kernel.hpp"
 #include "tree.hpp"
 
@@ -102,7 +103,7 @@ std::vector<tree_link<T>> cast_links(const std::vector<tree_link<S>>& links) {
 /// The link's constants may be in another scalar than q (a SIMD pack's states on double
 /// constants: scalar/simd.hpp), which the products broadcast.
 template <class T, class LS>
-void kernel_placement(const tree_link<LS>& k, const T& qi, mat3<T>& R, vec3<T>& p) {
+NHDYN_ALWAYS_INLINE void kernel_placement(const tree_link<LS>& k, const T& qi, mat3<T>& R, vec3<T>& p) {
   if (k.revolute) {
     // sincos_kernel for a double (no library call; the chain kernels' numbers), a dual's one
     // sin/cos of its value, an interval's pair, a SIMD pack's own (dh_kernel.hpp)
