@@ -8,8 +8,11 @@
 #   NHDYN_BENCH_FILTER='^rne/' scripts/bench.sh --no-docs   # a subset, JSON only (build-bench/performance.json;
 #                                          # scripts/merge_bench.py merges it into docs/performance.json)
 #   NHDYN_BENCH_CLANG=1 scripts/bench.sh   # the two-compiler table's kernels built by clang++-14
-#                                          # (build-bench-clang/, docs/performance-clang.json);
-#                                          # the tables are then regenerated from both JSON files
+#                                          # (build-bench-clang/), run alternating with the g++
+#                                          # build (build-bench/) in NHDYN_BENCH_SITTINGS sittings
+#                                          # (4): docs/performance-clang.json and
+#                                          # docs/performance-clang-gcc.json; the tables are then
+#                                          # regenerated from the JSON files
 #
 # Environment: NHDYN_BENCH_BUILD (build dir, default build-bench), NHDYN_BENCH_REPS (9),
 # NHDYN_BENCH_MIN_TIME (seconds per repetition, 0.1), NHDYN_BENCH_FILTER (regex, all),
@@ -46,21 +49,31 @@ scalar="${NHDYN_BENCH_SCALAR:-1}"
 targets=(nhdyn_bench); [ "$scalar" = 1 ] && targets+=(nhdyn_bench_scalar)
 make -C "$build" -j2 "${targets[@]}"
 
+run_bench() {  # run_bench BINARY OUT.json
+  "$1" --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true \
+    --benchmark_min_time="$min_time" --benchmark_filter="$filter" --benchmark_out="$2" --benchmark_out_format=json
+}
 json="$root/docs/performance.json"
-[ "$clang" = 1 ] && json="$root/docs/performance-clang.json"
 [ $docs -eq 0 ] && json="$build/performance.json"
-"$build/bench/nhdyn_bench" --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true \
-  --benchmark_min_time="$min_time" --benchmark_filter="$filter" \
-  --benchmark_out="$json" --benchmark_out_format=json
-echo "bench.sh: wrote $json"
-[ $docs -eq 0 ] && exit 0
-# clang: the g++ build's run of the same cases right after it (the two-compiler table's g++
-# column: the same sitting, as the machine's speed drifts from hour to hour)
-if [ "$clang" = 1 ] && [ -x "$root/build-bench/bench/nhdyn_bench" ]; then
-  "$root/build-bench/bench/nhdyn_bench" --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true \
-    --benchmark_report_aggregates_only=true --benchmark_min_time="$min_time" --benchmark_filter="$filter" \
-    --benchmark_out="$root/docs/performance-clang-gcc.json" --benchmark_out_format=json
-  echo "bench.sh: wrote $root/docs/performance-clang-gcc.json"
+if [ "$clang" = 1 ] && [ $docs -eq 1 ] && [ -x "$root/build-bench/bench/nhdyn_bench" ]; then
+  # clang: the clang build and the g++ build on the same cases, alternating in NHDYN_BENCH_SITTINGS
+  # sittings (default 4): the machine's speed drifts from minute to minute, and one case's
+  # clang/g++ ratio differed by up to 0.3 between sittings (2026-12-02); the table takes each
+  # case's median over the sittings
+  tmp="$(mktemp -d)"
+  sittings="${NHDYN_BENCH_SITTINGS:-4}"
+  for k in $(seq 1 "$sittings"); do
+    run_bench "$build/bench/nhdyn_bench" "$tmp/clang-$k.json"
+    run_bench "$root/build-bench/bench/nhdyn_bench" "$tmp/gcc-$k.json"
+  done
+  "$py" "$root/scripts/merge_bench.py" "$root/docs/performance-clang.json" --sittings "$tmp"/clang-*.json
+  "$py" "$root/scripts/merge_bench.py" "$root/docs/performance-clang-gcc.json" --sittings "$tmp"/gcc-*.json
+  rm -rf "$tmp"
+else
+  [ "$clang" = 1 ] && [ $docs -eq 1 ] && json="$root/docs/performance-clang.json"
+  run_bench "$build/bench/nhdyn_bench" "$json"
+  echo "bench.sh: wrote $json"
+  [ $docs -eq 0 ] && exit 0
 fi
 
 cpu="$(lscpu | sed -n 's/^Model name:[[:space:]]*//p' | head -1)"

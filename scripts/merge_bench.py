@@ -11,6 +11,12 @@ filter caught but whose tables divide them by cases it did not re-run). The main
 records the re-runs (`partial_reruns`: each one's date and the case names still its own), which
 perf_table.py states at the top of the page and uses to draw no ratio across runs where it must
 not (the clang table).
+
+    scripts/merge_bench.py OUT --sittings A.json B.json ...
+
+pools runs of the same cases made in several sittings (the two-compiler table's, which
+bench.sh makes alternating the two builds) into OUT: every entry kept, tagged with its
+sitting; perf_table.py takes a case's median over the sittings' medians.
 """
 import argparse
 import json
@@ -20,9 +26,24 @@ import re
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("main")
-    ap.add_argument("new")
+    ap.add_argument("new", nargs="?")
     ap.add_argument("--skip", help="run_names (regex) to keep from the main file")
+    ap.add_argument("--sittings", nargs="+", help="runs of the same cases to pool into MAIN (written anew)")
     a = ap.parse_args()
+    if a.sittings:
+        runs = []
+        for path in a.sittings:
+            with open(path) as f:
+                runs.append(json.load(f))
+        out = {"context": dict(runs[0]["context"], sittings=[r["context"]["date"] for r in runs]), "benchmarks": []}
+        for k, r in enumerate(runs):
+            out["benchmarks"] += [dict(b, sitting=k) for b in r["benchmarks"]]
+        with open(a.main, "w") as f:
+            json.dump(out, f, indent=1)
+        print(f"merge_bench: {len(runs)} sittings pooled into {a.main}")
+        return
+    if not a.new:
+        ap.error("NEW (the filtered run to merge) is required without --sittings")
     with open(a.main) as f:
         d = json.load(f)
     with open(a.new) as f:

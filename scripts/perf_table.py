@@ -14,6 +14,7 @@ import datetime
 import json
 import math
 import re
+import statistics
 import sys
 
 BEGIN = "<!-- BEGIN GENERATED: scripts/bench.sh -->"
@@ -70,7 +71,8 @@ def load(path):
     for b in data["benchmarks"]:
         name = b.get("run_name", b["name"])
         if b.get("aggregate_name") == "median":
-            med[name] = b["cpu_time"] * {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[b["time_unit"]]
+            # a file of several sittings (merge_bench.py --sittings) holds one median per sitting
+            med.setdefault(name, []).append(b["cpu_time"] * {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[b["time_unit"]])
             if "allocs_per_call" in b:
                 allocs[name] = b["allocs_per_call"]
             if "ratio" in b:  # a paired measurement (nh_pair/…): the median of its ratio counter
@@ -78,6 +80,7 @@ def load(path):
             reps[name] = b.get("repetitions", 1)
     if not med:
         sys.exit("perf_table.py: no median aggregates in %s (run with --benchmark_repetitions)" % path)
+    med = {name: statistics.median(v) for name, v in med.items()}  # over the sittings' medians
     return data["context"], med, allocs, reps
 
 
@@ -520,11 +523,37 @@ TARGET_CLANG = 1.1
 CLANG_FILTER = "^(" + "|".join(re.escape(n) for _, _, n in TWO_COMPILERS) + ")$"
 
 
-def two_compilers(med, second_med, second_compiler, first_compiler, rerun=frozenset(), baseline=None):
+def sitting_ratios(first_path, second_path):
+    """Per case, the ratio second / first of each sitting's medians (files of merge_bench.py --sittings)."""
+    per = {}
+    for k, path in enumerate((first_path, second_path)):
+        with open(path) as f:
+            for b in json.load(f)["benchmarks"]:
+                if b.get("aggregate_name") == "median":
+                    per.setdefault(b["run_name"], {}).setdefault(b.get("sitting", 0), [None, None])[k] = b["cpu_time"]
+    return {name: [s / f for f, s in v.values() if f and s] for name, v in per.items()}
+
+
+def widest_spread(ratios):
+    """The case whose sittings' ratios spread the most, as "name: lo–hi"."""
+    name, r = max(((n, r) for n, r in ratios.items() if len(r) > 1), key=lambda x: max(x[1]) - min(x[1]),
+                  default=(None, None))
+    return f"from {min(r):.2f} to {max(r):.2f} for {name}" if name else "one sitting only"
+
+
+def two_compilers(med, second_med, second_compiler, first_compiler, rerun=frozenset(), baseline=None, sittings=None,
+                  spread=None):
     out = ["### Two compilers: the same kernels built by clang (issue 33)\n"]
-    first = (f"and this page's build by {first_compiler} run on the same cases right after it "
-             f"(docs/performance-clang-gcc.json, {baseline}); medians, ns per call." if baseline else
-             f"beside this page's build by {first_compiler}; medians, ns per call, each build's own run.")
+    if sittings:  # the two builds alternated, sitting after sitting (bench.sh clang mode)
+        first = (f"and this page's build by {first_compiler} on the same cases, the two builds alternating in "
+                 f"{len(sittings)} sittings (docs/performance-clang-gcc.json, {sittings[0]} to {sittings[-1]}); "
+                 f"each figure is the median of the sittings' medians, ns per call. A single sitting's "
+                 f"ratio wanders: {spread}.")
+    elif baseline:
+        first = (f"and this page's build by {first_compiler} run on the same cases right after it "
+                 f"(docs/performance-clang-gcc.json, {baseline}); medians, ns per call.")
+    else:
+        first = f"beside this page's build by {first_compiler}; medians, ns per call, each build's own run."
     out.append(f"The benchmarks below from a second build of `nhdyn_bench` by {second_compiler} (same flags, "
                f"`NHDYN_BENCH_CLANG=1 scripts/bench.sh`: `build-bench-clang/`, docs/performance-clang.json), "
                f"{first}\n")
@@ -574,7 +603,9 @@ def main():
         second_ctx, second_med, _, _ = load(a.second)
         base_ctx, base_med, _, _ = load(a.second_baseline)
         text += two_compilers(base_med, second_med, a.second_compiler, a.compiler,
-                              baseline=f"{base_ctx['date']}; clang: {second_ctx['date']}")
+                              baseline=f"{base_ctx['date']}; clang: {second_ctx['date']}",
+                              sittings=base_ctx.get("sittings") if second_ctx.get("sittings") else None,
+                              spread=widest_spread(sitting_ratios(a.second_baseline, a.second)))
     elif a.second:
         second_ctx, second_med, _, _ = load(a.second)
         # each g++ median's run: the last filtered re-run that holds it, else the full run; a ratio
