@@ -535,7 +535,7 @@ def sitting_ratios(first_path, second_path):
 
 
 def widest_spread(ratios):
-    """The case whose sittings' ratios spread the most, as "name: lo–hi"."""
+    """The case whose sittings' ratios spread the most, as "from lo to hi for name"."""
     name, r = max(((n, r) for n, r in ratios.items() if len(r) > 1), key=lambda x: max(x[1]) - min(x[1]),
                   default=(None, None))
     return f"from {min(r):.2f} to {max(r):.2f} for {name}" if name else "one sitting only"
