@@ -602,10 +602,10 @@ def main():
     if a.second and a.second_baseline:  # (after tables(): the paired ratios of these files do not reach them)
         second_ctx, second_med, _, _ = load(a.second)
         base_ctx, base_med, _, _ = load(a.second_baseline)
+        sittings = base_ctx.get("sittings") if second_ctx.get("sittings") else None
         text += two_compilers(base_med, second_med, a.second_compiler, a.compiler,
-                              baseline=f"{base_ctx['date']}; clang: {second_ctx['date']}",
-                              sittings=base_ctx.get("sittings") if second_ctx.get("sittings") else None,
-                              spread=widest_spread(sitting_ratios(a.second_baseline, a.second)))
+                              baseline=f"{base_ctx['date']}; clang: {second_ctx['date']}", sittings=sittings,
+                              spread=widest_spread(sitting_ratios(a.second_baseline, a.second)) if sittings else None)
     elif a.second:
         second_ctx, second_med, _, _ = load(a.second)
         # each g++ median's run: the last filtered re-run that holds it, else the full run; a ratio
