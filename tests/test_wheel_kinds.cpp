@@ -392,6 +392,51 @@ TEST_CASE("inverse_dynamics on a tree: evaluate into a reused tau = the composit
   }
 }
 
+TEST_CASE("wheeled_base past the lift's inline memo (k |eta ∩ W| > 24): a drive axle and five castors; evaluate = the "
+          "call bit for bit, tau and lambda = the projected Euler-Lagrange equations, the memo copied and moved",
+          "[wheel_kinds]") {
+  // k = 3 (the axle) + 5 × 2 (the castors) = 13 rows, mobility 2: S_D has 13 × 2 = 26 entries,
+  // past the memo's 24 inline ones (its block then comes from the thread's scratch_blocks)
+  const std::vector<test_wheel> ws = {{"fixed", 0, 0.3},          {"fixed", 0, -0.3},         {"castor", 0.5, 0.3},
+                                      {"castor", 0.5, -0.3},      {"castor", -0.5, 0.3},      {"castor", -0.5, -0.3},
+                                      {"castor", 0.6, 0}};
+  const tree<double> t = planar_tree(ws);
+  const wheeled_base<double> c(t, wheels_of(ws), quiet());
+  REQUIRE(c.k() == 13);
+  REQUIRE(c.mobility() == 2);
+  const auto ref = nhdyn_ref::from_tree<LD>(t);
+  const auto id = inverse_dynamics(t, c);
+  const auto idf = inverse_dynamics_with_forces(t, c);
+  const auto fd = nh_forward_dynamics(t, c);
+  nh_forward_dynamics_result<double> into;
+  std::mt19937 rng(26);
+  VectorXd tau = VectorXd::Constant(c.p(), 7.0);
+  for (int trial = 0; trial < 3; ++trial) {
+    const VectorXd q = random_q(c.dof(), rng), eta = random_vec(c.m(), rng), eta_dot = random_vec(c.m(), rng, 2);
+    id.evaluate(q, eta, eta_dot, tau);
+    const VectorXd call = id(q, eta, eta_dot);
+    CHECK((tau.array() == call.array()).all());
+    const auto f = idf(q, eta, eta_dot);
+    const auto [tau_ref, lambda_ref] = projected_euler_lagrange(ref, c, q, eta, eta_dot);
+    CHECK(rel(call, tau_ref) <= 1e-11);
+    CHECK(rel(f.lambda, lambda_ref) <= 1e-11);
+    fd.evaluate(q, eta, call, into);
+    CHECK(rel(into.eta_dot, eta_dot) <= 1e-9);
+    CHECK((into.eta_dot.array() == fd(q, eta, call).array()).all());
+    // the memo: copies and moves keep S_D; the projection with any of them = the call's τ
+    VectorXd qd(c.dof()), qdd(c.dof());
+    auto m1 = c.lift_into(q, eta, eta_dot, qd, qdd);
+    const VectorXd v = rne(t)(q, qd, qdd);
+    auto m2 = m1;              // a copy: a block of its own
+    auto m3 = std::move(m1);   // a move: the block changes hands
+    decltype(m2) m4;
+    m4 = m2;                   // copy-assigned over an empty memo
+    m2 = std::move(m3);        // move-assigned over a copy
+    CHECK((c.project_with(q, v, m2).array() == call.array()).all());
+    CHECK((c.project_with(q, v, m4).array() == call.array()).all());
+  }
+}
+
 TEST_CASE("nh_forward_dynamics on a tree: evaluate into one reused result = the plain call bit for bit, for every "
           "robot file's constraint; η̇ against dense SᵀMS and Eigen's LDLT, and against the inverse dynamics",
           "[wheel_kinds]") {

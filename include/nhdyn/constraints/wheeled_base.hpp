@@ -41,6 +41,7 @@
 #include <cmath>
 #include <functional>
 #include <iostream>
+#include <memory>
 #include <numbers>
 #include <numeric>
 #include <sstream>
@@ -458,37 +459,60 @@ class wheeled_base {
 
   /// What the lift leaves for the projection (carried through rne with (q, v)): S's dependent
   /// rows S_D (k × |η ∩ W|, column-major) at the lift's q, so that the projection does not form
-  /// A again.
+  /// A again. Up to 24 entries inline; beyond, in a block borrowed from the thread's
+  /// detail::scratch_blocks (given back when the memo goes), so that a lift on a base of any
+  /// size allocates nothing once its thread has met that size.
   template <class T>
   struct memo {
     static constexpr int inline_capacity = 24;
     memo() = default;
     memo(const memo& o) { assign(o.data(), o.size); }
-    memo(memo&& o) noexcept : large(std::move(o.large)), size(o.size) {
-      if (size <= inline_capacity) std::copy(o.small.begin(), o.small.begin() + size, small.begin());
+    memo(memo&& o) noexcept : size(o.size) {
+      if (size <= inline_capacity)
+        std::copy(o.small.begin(), o.small.begin() + size, small.begin());
+      else
+        large = std::move(o.large), o.size = 0;
     }
     memo& operator=(const memo& o) {
       if (this != &o) assign(o.data(), o.size);
       return *this;
     }
     memo& operator=(memo&& o) noexcept {
-      size = o.size;
-      large = std::move(o.large);
-      if (size <= inline_capacity) std::copy(o.small.begin(), o.small.begin() + size, small.begin());
+      if (this == &o) return *this;
+      if (o.size <= inline_capacity) {
+        release();
+        std::copy(o.small.begin(), o.small.begin() + o.size, small.begin());
+        size = o.size;
+      } else {
+        release();
+        large = std::move(o.large);
+        size = std::exchange(o.size, 0);
+      }
       return *this;
     }
+    ~memo() { release(); }
     const T* data() const { return size <= inline_capacity ? small.data() : large.data(); }
     void assign(const T* from, int n) {
-      size = n;
-      if (n <= inline_capacity)
+      release();
+      if (n <= inline_capacity) {
         std::copy(from, from + n, small.begin());
-      else
-        large.assign(from, from + n);
+      } else {
+        large = detail::scratch_blocks<T>::take(static_cast<std::size_t>(n));
+        std::uninitialized_copy(from, from + n, large.data());  // if a copy throws, size stays 0 and the block is freed
+      }
+      size = n;
     }
 
    private:
-    std::array<T, inline_capacity> small;  ///< S_D when k·|η ∩ W| ≤ 24 (no allocation; only `size` entries copied)
-    std::vector<T> large{};                ///< else here
+    void release() noexcept {
+      if (size > inline_capacity && large.data()) {
+        std::destroy_n(large.data(), size);
+        detail::scratch_blocks<T>::give_back(std::move(large));
+      }
+      size = 0;
+    }
+    std::array<T, inline_capacity> small;               ///< S_D when k·|η ∩ W| ≤ 24 (only `size` entries copied)
+    typename detail::scratch_blocks<T>::block large{};  ///< else here: `size` constructed entries
     int size = 0;
   };
 
