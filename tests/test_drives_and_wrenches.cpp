@@ -93,6 +93,9 @@ TEST_CASE("puma560_motors reproduces the Robotics Toolbox's published rne, inert
   w.moment = -Vector3d(1, 2, 3);
   const auto fext = external_wrenches(p, {w});
   printed(rne(p)(qn, z, z, fext), {"0.642756", "29.0866", "4.70321", "2.82843", "-1.97175", "3"});
+  VectorXd v(6);
+  rne(p).evaluate(qn, z, z, fext, v);  // into storage: the same numbers
+  CHECK((v.array() == rne(p)(qn, z, z, fext).array()).all());
   // inertia: M(qn)'s diagonal (armature included), and M q̈ (test_itorque)
   const MatrixXd M = mass_matrix(p)(qn);
   printed(M.diagonal(), {"3.6594", "4.4137", "0.9378", "0.1925", "0.1713", "0.1941"});
@@ -305,6 +308,26 @@ TEST_CASE("external wrenches: the textbook RNEA with body forces, KDL-free Jacob
       // (4) the pipeline stage: (q, v) ↦ (q, v − Q_ext)
       const auto g = fx(generalized_forces<double>{q, rne(t)(q, qd, qdd)});
       CHECK(rel(g.v, tau) <= 1e-15);
+      // (5) Q_ext = Σ Jᵀ [f; m] with each wrench's Jacobian (tree_kinematics, one per wrench)
+      VectorXd Qj = VectorXd::Zero(n);
+      for (const auto& w : W) {
+        if (w.body == 0) continue;
+        const auto R = kin.frame(q, w.body).R;
+        const Vector3d f = w.frame == wrench_frame::body ? Vector3d(R * w.force) : w.force;
+        const Vector3d m = w.frame == wrench_frame::body ? Vector3d(R * w.moment) : w.moment;
+        const MatrixXd J = kin.jacobian(q, w.body, w.point);
+        Qj += J.topRows(3).transpose() * f + J.bottomRows(3).transpose() * m;
+      }
+      CHECK(rel(fx.generalized_force(q), Qj) <= 1e-14);
+      // (6) the evaluate forms with wrenches: the calls' numbers bit for bit, into reused storage
+      VectorXd v = VectorXd::Constant(n, 7.0), a = VectorXd::Constant(n, 7.0), b;
+      rne(t).evaluate(q, qd, qdd, fx, v);
+      CHECK((v.array() == tau.array()).all());
+      aba(t).evaluate(q, qd, tau, fx, a);
+      CHECK((a.array() == aba(t)(q, qd, tau, fx).array()).all());
+      forward_dynamics_scratch<double, dynamic> ws;
+      forward_dynamics(t).evaluate(q, qd, tau, fx, ws, b);
+      CHECK((b.array() == forward_dynamics(t)(q, qd, tau, fx).array()).all());
     }
   }
 }
@@ -320,6 +343,7 @@ TEST_CASE("external wrenches on a mobile manipulator: id, lambda and fd with a p
   const auto id = lift(c) | rne(t) | fx | constraint_forces(c);
   const auto id0 = inverse_dynamics_with_forces(t, c);
   const auto fd = nh_forward_dynamics(t, c);
+  nh_forward_dynamics_result<double> into;
   std::mt19937_64 rng(3);
   for (int trial = 0; trial < 10; ++trial) {
     const VectorXd q = random_vec(rng, 5, 2), eta = random_vec(rng, 4, 1), eta_dot = random_vec(rng, 4, 2);
@@ -330,8 +354,11 @@ TEST_CASE("external wrenches on a mobile manipulator: id, lambda and fd with a p
     const auto split = constraint_forces(c)(q, Qx);
     CHECK(rel(VectorXd(with.tau), VectorXd(without.tau - split.tau)) <= 1e-12);
     CHECK(rel(VectorXd(with.lambda), VectorXd(without.lambda - split.lambda)) <= 1e-12);
-    // the constrained forward dynamics with the same wrenches inverts it
-    CHECK(rel(VectorXd(fd(q, eta, VectorXd(with.tau), fx)), eta_dot) <= 1e-10);
+    // the constrained forward dynamics with the same wrenches inverts it; evaluate = the call
+    const VectorXd back = fd(q, eta, VectorXd(with.tau), fx);
+    CHECK(rel(back, eta_dot) <= 1e-10);
+    fd.evaluate(q, eta, VectorXd(with.tau), fx, into);
+    CHECK((into.eta_dot.array() == back.array()).all());
   }
   // the named forms: a merged frame's name, an unknown name, bad numbers
   CHECK_THROWS_WITH(wrench_on(t, "gripper", wrench_frame::world, Vector3d(0, 0, 0), Vector3d(1, 1, 1)),

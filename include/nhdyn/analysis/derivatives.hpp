@@ -578,8 +578,7 @@ class fd_derivatives_fn {
     requires detail::in_scalar<S, Q, QD, TAU>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                 const external_wrenches_fn<Kin, S>& w, fd_derivatives_result<S>& out) const {
-    detail::check_size(tau, dof(), "tau");
-    fd_.evaluate(q, qd, detail::plus_applied(tau, w, q), out.fd, out.qdd);
+    fd_.evaluate(q, qd, tau, w, out.fd, out.qdd);  // τ + Q_ext in out.fd's scratch: no allocation
     d_.evaluate(q, qd, out.qdd, w, out.id);
     solve(out);
   }

@@ -34,6 +34,7 @@ struct nh_forward_dynamics_result {
   vecN<T, N> qd;                    ///< q̇ = S η
   // scratch (no meaning between calls)
   vecN<T, N> sdeta, v;
+  vecN<T, N> applied;  ///< Q_ext(q) of the applied forces, when given
   matrix<T, N, M> MS;
   detail::column_pattern<N, M> pattern;
 };
@@ -136,7 +137,7 @@ class nh_forward_dynamics_fn : public stage_tag {
   /// result's fields), in storage reused from call to call: no heap allocation after the first
   /// call of a size on a tree, with every constraint a robot file makes (differential_drive,
   /// rolling_wheels, bicycle, wheeled_base) and the crba method (default). Friction's τ_f(q̇),
-  /// applied forces' Q_ext(q), `holonomic`'s and `user_constraint`'s S(q) and the rne_columns
+  /// `holonomic`'s and `user_constraint`'s S(q) and the rne_columns
   /// method allocate their own results. The same numbers as the plain call, bit for bit (the
   /// plain call is this into a new result). `out` must not alias the inputs.
   template <class Q, class E, class TAU, class T>
@@ -144,13 +145,20 @@ class nh_forward_dynamics_fn : public stage_tag {
                 nh_forward_dynamics_result<T, N, M>& out) const {
     solve_into(q, eta, tau, static_cast<const vecN<T, N>*>(nullptr), out);
   }
-  /// …with applied forces (their Q_ext(q) is allocated by the applied-forces object).
+  /// …with applied forces: Q_ext(q) into the result's `applied` (no allocation where the
+  /// applied forces write into storage, as external_wrenches does, and Q_ext's scalar is T).
   template <class Q, class E, class TAU, applied_forces F, class T>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                 const F& fx, nh_forward_dynamics_result<T, N, M>& out) const {
     detail::check_size(q, c_.dof(), "q");
-    const auto Qx = fx.generalized_force(q);
-    solve_into(q, eta, tau, &Qx, out);
+    if constexpr (std::is_same_v<detail::applied_scalar_t<F, Q>, T>) {
+      out.applied.resize(c_.dof());
+      detail::generalized_force_into(fx, q, out.applied);
+      solve_into(q, eta, tau, &out.applied, out);
+    } else {
+      const auto Qx = fx.generalized_force(q);
+      solve_into(q, eta, tau, &Qx, out);
+    }
   }
 
   /// The state derivative for integrators: x = (q, η) ↦ ẋ = (q̇, η̇) = (S η, η̇), n + m entries.

@@ -303,6 +303,20 @@ class aba_fn : public stage_tag {
     detail::check_size(tau, dof(), "tau");
     return (*this)(q, qd, detail::plus_applied(tau, fx, q));
   }
+  /// …into qdd (of the model's, the inputs' and Q_ext's promoted scalar): the call's numbers
+  /// bit for bit; τ + Q_ext in stack scratch, so no allocation where the applied forces write
+  /// into storage (external_wrenches does).
+  template <class Q, class QD, class TAU, applied_forces F, class QDD>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
+                const F& fx, Eigen::MatrixBase<QDD>& qdd) const {
+    using R = promote_t<typename TAU::Scalar, detail::applied_scalar_t<F, Q>>;
+    detail::check_size(tau, dof(), "tau");
+    detail::small_buffer<R, dynamic> buf(dof());
+    Eigen::Map<vecN<R, dynamic>> t(buf.data(), dof());
+    t = tau.template cast<R>();
+    detail::add_applied<+1>(fx, q, t);
+    evaluate(q, qd, t, qdd);
+  }
 
  private:
   static double sq(double x) { return x * x; }

@@ -50,7 +50,7 @@ struct forward_dynamics_scratch {
   Eigen::Matrix<T, N, N> M;
   vecN<T, N> h;
   ldlt<T, N> factor;
-  vecN<T, N> net;  ///< τ − τ_f(q̇), with a friction model
+  vecN<T, N> net;  ///< τ − τ_f(q̇), with a friction model; τ + Q_ext(q) (− τ_f), with applied forces
 };
 
 /// Model: chain<S, N> or tree<S> (N = dynamic).
@@ -132,6 +132,29 @@ class forward_dynamics_fn : public stage_tag {
     } else {
       solve_into(q, qd, tau, ws, qdd);
     }
+  }
+  /// …with applied forces (external wrenches, dynamics/wrench.hpp): q̈ for τ + Q_ext(q), the
+  /// call's numbers bit for bit; τ + Q_ext in ws.net, so no allocation where the applied forces
+  /// write into storage (external_wrenches does).
+  template <class Q, class QD, class TAU, applied_forces F>
+    requires std::is_same_v<typename Q::Scalar, S> && std::is_same_v<typename QD::Scalar, S> &&
+             std::is_same_v<typename TAU::Scalar, S> && std::is_same_v<detail::applied_scalar_t<F, Q>, S>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
+                const F& fx, forward_dynamics_scratch<S, N>& ws, vecN<S, N>& qdd) const {
+    detail::check_size(q, n_, "q");
+    detail::check_size(qd, n_, "qd");
+    detail::check_size(tau, n_, "tau");
+    qdd.resize(n_);  // τ + Q_ext here until the solve
+    qdd = tau;
+    detail::add_applied<+1>(fx, q, qdd);
+    detail::check_finite(qdd, "tau");
+    if (friction_) {  // (τ + Q_ext) − τ_f(q̇), as the call forms it
+      friction_->evaluate(qd, ws.net);
+      ws.net = qdd - ws.net;
+    } else {
+      ws.net = qdd;
+    }
+    solve_into(q, qd, ws.net, ws, qdd);
   }
 
  private:

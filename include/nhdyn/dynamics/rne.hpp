@@ -291,6 +291,15 @@ class rne_fn : public stage_tag {
     run(q, qd, qdd, v.derived());
     detail::check_result(v, q, qd, qdd, "rne");
   }
+  /// v = rne(q, q̇, q̈) − Q_ext(q) into v (applied forces: external wrenches,
+  /// dynamics/wrench.hpp): the call's numbers bit for bit, no allocation (Q_ext in stack
+  /// scratch) where the applied forces write into storage, as external_wrenches does.
+  template <class Q, class QD, class QDD, applied_forces F, class V>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
+                const F& fx, Eigen::MatrixBase<V>& v) const {
+    evaluate(q, qd, qdd, v);
+    detail::add_applied<-1>(fx, q, v);
+  }
 
   /// With applied forces (external wrenches, dynamics/wrench.hpp): v − Q_ext(q).
   template <class Q, class QD, class QDD, applied_forces F>

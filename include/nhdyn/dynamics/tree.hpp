@@ -332,6 +332,15 @@ class tree_rne_fn : public stage_tag {
       run(detail::cast_links<T>(links_));
     detail::check_overflow(v.derived(), "rne");
   }
+  /// v = rne(q, q̇, q̈) − Q_ext(q) into v (applied forces: external wrenches,
+  /// dynamics/wrench.hpp): the call's numbers bit for bit, no allocation (Q_ext in stack
+  /// scratch) where the applied forces write into storage, as external_wrenches does.
+  template <class Q, class QD, class QDD, applied_forces F, class V>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
+                const F& fx, Eigen::MatrixBase<V>& v) const {
+    evaluate(q, qd, qdd, v);
+    detail::add_applied<-1>(fx, q, v);
+  }
 
  private:
   std::vector<detail::tree_link<S>> links_;

@@ -22,7 +22,9 @@
 /// or the body frame's (`body`: a thrust that turns with the body). The base is the model's
 /// world-fixed root (a mobile robot's planar base joints are ordinary joints before it).
 ///
-/// Cost: two kinematic passes per wrench (pose and Jacobian), O(n) each.
+/// Cost: one kinematic pass for all the wrenches, then a walk from each wrench's body to the root;
+/// no allocation in `generalized_force_into` and in the dynamics' `evaluate` forms that take
+/// wrenches.
 #include <Eigen/Core>
 #include <initializer_list>
 #include <string>
@@ -81,20 +83,20 @@ class external_wrenches_fn : public stage_tag {
   template <class Q>
   auto generalized_force(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<promote_t<typename Kin::scalar_type, typename Q::Scalar>, W>;
-    Eigen::Matrix<T, Eigen::Dynamic, 1> out = Eigen::Matrix<T, Eigen::Dynamic, 1>::Zero(kin_.dof());
-    for (const auto& x : w_) {
-      if (x.body == 0) continue;
-      vec3<T> f = x.force.template cast<T>(), m = x.moment.template cast<T>();
-      if (x.frame == wrench_frame::body) {
-        const auto R = kin_.frame(q, x.body).R;
-        f = R.template cast<T>() * f;
-        m = R.template cast<T>() * m;
-      }
-      const auto J = kin_.jacobian(q, x.body, x.point.template cast<typename Kin::scalar_type>());
-      out += J.template topRows<3>().transpose().template cast<T>() * f +
-             J.template bottomRows<3>().transpose().template cast<T>() * m;
-    }
+    Eigen::Matrix<T, Eigen::Dynamic, 1> out(kin_.dof());
+    generalized_force_into(q, out);
     return out;
+  }
+  /// The same into out (n entries, of the model's, q's and the wrenches' promoted scalar; a
+  /// vector or a map the caller reuses): no allocation (`has_generalized_force_into`).
+  template <class Q, class Out>
+  void generalized_force_into(const Eigen::MatrixBase<Q>& q, Eigen::MatrixBase<Out>& out) const {
+    static_assert(std::is_same_v<typename Out::Scalar,
+                                 promote_t<promote_t<typename Kin::scalar_type, typename Q::Scalar>, W>>,
+                  "out's scalar is the model's, q's and the wrenches' promoted scalar");
+    detail::check_size(out, kin_.dof(), "Q_ext");
+    out.setZero();
+    kin_.add_point_forces(q, w_, [](const wrench<W>& x) { return x.frame == wrench_frame::body; }, out);
   }
 
   /// Pipeline form: (q, v) ↦ (q, v − Q_ext(q)), after rne, before the projection.
@@ -104,8 +106,13 @@ class external_wrenches_fn : public stage_tag {
       x.v;
     }
   auto operator()(F f) const {
-    const auto Qx = generalized_force(f.q);
-    f.v -= Qx.template cast<typename decltype(f.v)::Scalar>();
+    using V = typename decltype(f.v)::Scalar;
+    if constexpr (std::is_same_v<promote_t<V, detail::applied_scalar_t<external_wrenches_fn, decltype(f.q)>>, V>) {
+      detail::add_applied<-1>(*this, f.q, f.v);  // Q_ext in stack scratch: no allocation
+    } else {
+      const auto Qx = generalized_force(f.q);
+      f.v -= Qx.template cast<V>();
+    }
     return f;
   }
 

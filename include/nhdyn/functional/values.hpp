@@ -3,6 +3,7 @@
 /// The small named values that flow between pipeline stages. Each carries q along so
 /// that a later stage that needs the configuration (a projection) gets it without a
 /// back-channel.
+#include "../detail/small_buffer.hpp"
 #include "../model/chain.hpp"
 
 namespace nhdyn {
@@ -60,6 +61,37 @@ auto minus_applied(const V& v, const F& fx, const Q& q) {
   using R = promote_t<typename V::Scalar, typename decltype(Qx)::Scalar>;
   vecN<R, N> out = v.template cast<R>() - Qx.template cast<R>();
   return out;
+}
+/// Q_ext(q)'s scalar for applied forces F at a q of Q's scalar.
+template <class F, class Q>
+using applied_scalar_t = typename decltype(std::declval<const F&>().generalized_force(std::declval<const Q&>()))::Scalar;
+/// Q_ext(q) into out (n entries of its own scalar): into the storage where F writes into
+/// storage (`generalized_force_into`: external wrenches do), else from F's new vector.
+template <class F, class Q, class Out>
+void generalized_force_into(const F& fx, const Q& q, Out& out) {
+  if constexpr (requires { fx.generalized_force_into(q, out); })
+    fx.generalized_force_into(q, out);
+  else
+    out = fx.generalized_force(q).template cast<typename Out::Scalar>();
+}
+/// v −= Q_ext(q) (sign −1) or v += Q_ext(q) (sign +1), entry by entry, in v's scalar (which
+/// must hold Q_ext's): the numbers of minus_applied and plus_applied, Q_ext in stack scratch
+/// (beyond 4096 entries, a block the thread keeps) — no allocation where F writes into storage.
+template <int Sign, class F, class Q, class V>
+void add_applied(const F& fx, const Q& q, Eigen::MatrixBase<V>& v) {
+  using R = applied_scalar_t<F, Q>;
+  using T = typename V::Scalar;
+  static_assert(std::is_same_v<promote_t<T, R>, T>, "the result's scalar holds Q_ext's");
+  const int n = static_cast<int>(v.size());
+  small_buffer<R, dynamic> buf(n);
+  Eigen::Map<vecN<R, dynamic>> Qx(buf.data(), n);
+  generalized_force_into(fx, q, Qx);
+  for (int j = 0; j < n; ++j) {
+    if constexpr (Sign < 0)
+      v(j) = v(j) - T(Qx(j));
+    else
+      v(j) = v(j) + T(Qx(j));
+  }
 }
 /// τ + Q_ext(q) in the common scalar: what the forward dynamics solve for with applied forces.
 template <class Tau, class F, class Q>

@@ -54,6 +54,13 @@ class kinematics {
   template <class Q>
   auto forward(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<S, typename Q::Scalar>;
+    std::vector<pose<T>> X(static_cast<std::size_t>(n_ + 1));
+    forward_into(q, X.data());
+    return X;
+  }
+  /// …into X (n + 1 poses; X[0] is left as it is, the identity of a new pose).
+  template <class Q, class T>
+  void forward_into(const Eigen::MatrixBase<Q>& q, pose<T>* X) const {
     detail::check_size(q, n_, "q");
     detail::check_finite(q, "q");
     // X_0i = X_0,i−1 · A_i: an inclusive scan of the link transforms (Spong eq. 3.10).
@@ -65,9 +72,7 @@ class kinematics {
     const auto then = [](const pose<T>& X_0a, const pose<T>& X_ab) {
       return pose<T>{X_0a.R * X_ab.R, X_0a.p + X_0a.R * X_ab.p};
     };
-    std::vector<pose<T>> X(static_cast<std::size_t>(n_ + 1));
-    ranges::partial_sum(ranges::views::iota(0, n_) | ranges::views::transform(A_i), X.begin() + 1, then);
-    return X;
+    ranges::partial_sum(ranges::views::iota(0, n_) | ranges::views::transform(A_i), X + 1, then);
   }
 
   /// Pose of frame i (0…n) in frame 0.
@@ -106,6 +111,40 @@ class kinematics {
       }
     }
     return J;
+  }
+
+  /// out += Σ_x J(q, x.body, x.point)ᵀ [f_x; m_x] (n entries, of the model's and q's promoted
+  /// scalar or a wider one): the joint forces of forces f_x at points fixed on links and of
+  /// moments m_x (the principle of virtual work). Each x of `xs` has members `body` (link
+  /// 0…n; 0, the base, moves nothing), `point` (link coordinates), `force` and `moment`, given
+  /// in frame 0's axes, or in link x.body's where `in_body_axes(x)`. One forward pass for all:
+  /// no allocation (the frames on the stack; beyond 340 links, a block the thread keeps).
+  template <class Q, class Xs, class InBody, class Out>
+  void add_point_forces(const Eigen::MatrixBase<Q>& q, const Xs& xs, InBody in_body_axes, Eigen::MatrixBase<Out>& out) const {
+    using TK = promote_t<S, typename Q::Scalar>;
+    using T = typename Out::Scalar;
+    detail::check_size(out, n_, "out");
+    detail::small_buffer<pose<TK>, N == dynamic ? dynamic : N + 1> X(n_ + 1);
+    forward_into(q, X.data());
+    X[0] = pose<TK>{};
+    for (const auto& x : xs) {
+      check_link(x.body, true);
+      const int i = x.body;
+      if (i == 0) continue;
+      const auto& Xi = X[i];
+      const vec3<T> p = (Xi.p + Xi.R * x.point.template cast<TK>()).template cast<T>();
+      vec3<T> f = x.force.template cast<T>(), m = x.moment.template cast<T>();
+      if (in_body_axes(x)) {
+        const mat3<T> R = Xi.R.template cast<T>();
+        f = R * f;
+        m = R * m;
+      }
+      for (int j = 0; j < i; ++j) {  // frame j−1 of joint j (0-based j): z · ((p − o) × f + m), or z · f
+        const vec3<T> z = X[j].R.col(2).template cast<T>();
+        out(j) += links_[std::size_t(j)].revolute ? T(z.dot(vec3<T>((p - X[j].p.template cast<T>()).cross(f) + m)))
+                                                  : T(z.dot(f));
+      }
+    }
   }
 
   /// J̇q̇ of point p_i of link i, in frame 0: its acceleration at q̈ = 0, no gravity.

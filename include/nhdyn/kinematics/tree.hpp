@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "../detail/small_buffer.hpp"
 #include "../model/tree_kernel.hpp"
 #include "kinematics.hpp"
 
@@ -86,6 +87,41 @@ class tree_kinematics {
     return J;
   }
 
+  /// out += Σ_x J(q, x.body, x.point)ᵀ [f_x; m_x] (n entries, of the model's and q's promoted
+  /// scalar or a wider one): the joint forces of forces f_x at points fixed on bodies and of
+  /// moments m_x (the principle of virtual work). Each x of `xs` has members `body` (0…n; 0, the
+  /// base, moves nothing), `point` (body coordinates), `force` and `moment`, given in the base
+  /// frame's axes, or in body x.body's where `in_body_axes(x)`. One pass for the frames, then
+  /// each point walks to the root: no allocation (the frames on the stack; beyond 340 bodies, a
+  /// block the thread keeps, detail/small_buffer.hpp).
+  template <class Q, class Xs, class InBody, class Out>
+  void add_point_forces(const Eigen::MatrixBase<Q>& q, const Xs& xs, InBody in_body_axes, Eigen::MatrixBase<Out>& out) const {
+    using TK = promote_t<S, typename Q::Scalar>;
+    using T = typename Out::Scalar;
+    detail::check_size(out, n_, "out");
+    detail::small_buffer<pose<TK>, dynamic> K(n_);
+    kernel_frames_into(q, K.data());
+    for (const auto& x : xs) {
+      check_body(x.body);
+      if (x.body == 0) continue;
+      const int i = x.body - 1;
+      const auto& kb = links_[std::size_t(i)];
+      const vec3<TK> r = kb.R_KB.template cast<TK>() * x.point.template cast<TK>() + kb.p_KB.template cast<TK>();
+      const vec3<T> p = (K[i].p + K[i].R * r).template cast<T>();
+      vec3<T> f = x.force.template cast<T>(), m = x.moment.template cast<T>();
+      if (in_body_axes(x)) {
+        const mat3<T> Rb = (K[i].R * kb.R_KB.template cast<TK>()).template cast<T>();
+        f = Rb * f;
+        m = Rb * m;
+      }
+      for (int j = i; j >= 0; j = links_[std::size_t(j)].parent) {  // z_j · ((p − o_j) × f + m), or z_j · f
+        const vec3<T> z = K[j].R.col(2).template cast<T>();
+        out(j) += links_[std::size_t(j)].revolute ? T(z.dot(vec3<T>((p - K[j].p.template cast<T>()).cross(f) + m)))
+                                                  : T(z.dot(f));
+      }
+    }
+  }
+
   /// J̇q̇ of point p_i of body i, in the base frame: its acceleration at q̈ = 0, no gravity.
   template <class Q, class QD>
   auto jdot_qdot(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, int i,
@@ -136,10 +172,15 @@ class tree_kinematics {
   /// Poses of the kernel frames K_0…K_{n−1} in the base frame.
   template <class Q>
   auto kernel_frames(const Eigen::MatrixBase<Q>& q) const {
-    using T = promote_t<S, typename Q::Scalar>;
+    std::vector<pose<promote_t<S, typename Q::Scalar>>> K(static_cast<std::size_t>(n_));
+    kernel_frames_into(q, K.data());
+    return K;
+  }
+  /// …into K (n poses).
+  template <class Q, class T>
+  void kernel_frames_into(const Eigen::MatrixBase<Q>& q, pose<T>* K) const {
     detail::check_size(q, n_, "q");
     detail::check_finite(q, "q");
-    std::vector<pose<T>> K(static_cast<std::size_t>(n_));
     for (int i = 0; i < n_; ++i) {
       const auto k = links_[std::size_t(i)].template cast<T>();
       mat3<T> R;
@@ -150,7 +191,6 @@ class tree_kinematics {
       else
         K[i] = {K[k.parent].R * R, K[k.parent].p + K[k.parent].R * p};
     }
-    return K;
   }
   static void check_point(const vec3<S>& p_i) {
     for (int r = 0; r < 3; ++r)
