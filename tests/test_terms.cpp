@@ -132,6 +132,14 @@ TEST_CASE("terms: forward dynamics with friction inverts rne + friction, holonom
       CHECK((fd(q, eta, tau) - eta_dot).cwiseAbs().maxCoeff() <= 1e-10);
       CHECK((fd_t(q, eta, tau) - eta_dot).cwiseAbs().maxCoeff() <= 1e-10);
       CHECK((VectorXd(id_t(q, eta, eta_dot).tau) - tau).cwiseAbs().maxCoeff() <= 1e-10);
+      nh_forward_dynamics_result<double, dynamic, 4> into;  // evaluate adds τ_f in place: the call's numbers
+      fd_t.evaluate(q, eta, tau, into);
+      CHECK((into.eta_dot.array() == fd_t(q, eta, tau).array()).all());
+      const VectorXd w = rand_vec(g, 5);
+      VectorXd v = rand_vec(g, 5);
+      const VectorXd sum = v + fr(w);
+      fr.add_to(w, v);
+      CHECK((v.array() == sum.array()).all());
       // with friction the torques differ from the frictionless ones by the projected
       // friction: (SᵀE)⁻¹Sᵀ τ_f(Sη), E = S here
       const MatrixXd S = c.S(q);

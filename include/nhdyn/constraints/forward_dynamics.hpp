@@ -136,8 +136,8 @@ class nh_forward_dynamics_fn : public stage_tag {
   /// η̇ into `out.eta_dot`, with M(q), S(q), M_η, its factor, h_η and SᵀEτ beside it (the
   /// result's fields), in storage reused from call to call: no heap allocation after the first
   /// call of a size on a tree, with every constraint a robot file makes (differential_drive,
-  /// rolling_wheels, bicycle, wheeled_base) and the crba method (default). Friction's τ_f(q̇),
-  /// `holonomic`'s and `user_constraint`'s S(q) and the rne_columns
+  /// rolling_wheels, bicycle, wheeled_base) and the crba method (default), with or without
+  /// friction and applied forces. `holonomic`'s and `user_constraint`'s S(q) and the rne_columns
   /// method allocate their own results. The same numbers as the plain call, bit for bit (the
   /// plain call is this into a new result). `out` must not alias the inputs.
   template <class Q, class E, class TAU, class T>
@@ -254,7 +254,7 @@ class nh_forward_dynamics_fn : public stage_tag {
       out.reduced_inertia = reduced_inertia(q).template cast<T>();
     }
     bias_into(q, eta, out);
-    if (friction_) out.v += (*friction_)(out.qd).template cast<T>();
+    if (friction_) friction_->add_to(out.qd, out.v);  // out.v += τ_f(q̇): no new vector
     if (Qx) out.v -= Qx->template cast<T>();
     out.reduced_bias.resize(m);
     out.pattern.St_times(out.S, out.v, out.reduced_bias);

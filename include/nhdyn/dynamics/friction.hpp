@@ -119,6 +119,21 @@ class friction_fn : public stage_tag {
     out.resize(dof());
     fill(qd, out);
   }
+  /// out += τ_f(q̇) (n entries), each entry computed as the call computes it, converted to out's
+  /// scalar and added: `out += f(qd).cast<…>()`'s numbers without the new vector.
+  template <class QD, class Out>
+  void add_to(const Eigen::MatrixBase<QD>& qd, Eigen::MatrixBase<Out>& out) const {
+    using T = promote_t<double, typename QD::Scalar>;
+    using R = typename Out::Scalar;
+    detail::check_size(qd, dof(), "qd");
+    detail::check_finite(qd, "qd");
+    detail::check_size(out, dof(), "out");
+    for (int i = 0; i < dof(); ++i) {
+      const auto& f = f_[std::size_t(i)];
+      const T x = T(qd(i));
+      out(i) += R(T(T(f.viscous) * x + detail::coulomb_term(x, f.coulomb_pos, f.coulomb_neg, law_)));
+    }
+  }
   template <class Q, class QD, class QDD>
   auto operator()(const Eigen::MatrixBase<Q>&, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>&) const {
     return (*this)(qd);
