@@ -465,7 +465,8 @@ class forward_dynamics_linearizer {
     } else {
       const vecN<T, dynamic> tau_id = id_tau_(qt, et, eta_dot);
       detail::redundant_eta_scratch<T> ws;
-      detail::redundant_eta_rows(c_, qt, c_.S(qt), J.dq(), J.deta(), J.deta_dot(), tau, tau_id, out.A, out.B, ws);
+      const auto s = out.A.block(0, n, n, m);  // S(q), formed above
+      detail::redundant_eta_rows(c_, qt, s, J.dq(), J.deta(), J.deta_dot(), tau, tau_id, out.A, out.B, ws);
     }
     return out;
   }
