@@ -88,7 +88,7 @@ class external_wrenches_fn : public stage_tag {
     return out;
   }
   /// The same into out (n entries, of the model's, q's and the wrenches' promoted scalar; a
-  /// vector or a map the caller reuses): no allocation (`has_generalized_force_into`).
+  /// vector or a map the caller reuses): no allocation. The dynamics' `evaluate` forms use it.
   template <class Q, class Out>
   void generalized_force_into(const Eigen::MatrixBase<Q>& q, Eigen::MatrixBase<Out>& out) const {
     static_assert(std::is_same_v<typename Out::Scalar,
