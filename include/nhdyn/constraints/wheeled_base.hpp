@@ -479,12 +479,11 @@ class wheeled_base {
     }
     memo& operator=(memo&& o) noexcept {
       if (this == &o) return *this;
+      release();
       if (o.size <= inline_capacity) {
-        release();
         std::copy(o.small.begin(), o.small.begin() + o.size, small.begin());
         size = o.size;
       } else {
-        release();
         large = std::move(o.large);
         size = std::exchange(o.size, 0);
       }

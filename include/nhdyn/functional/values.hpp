@@ -54,14 +54,6 @@ template <class F>
 concept applied_forces = requires { typename std::remove_cvref_t<F>::applied_forces_tag; };
 
 namespace detail {
-/// v − Q_ext(q), N entries in the common scalar: what rne returns with applied forces.
-template <int N, class V, class F, class Q>
-auto minus_applied(const V& v, const F& fx, const Q& q) {
-  const auto Qx = fx.generalized_force(q);
-  using R = promote_t<typename V::Scalar, typename decltype(Qx)::Scalar>;
-  vecN<R, N> out = v.template cast<R>() - Qx.template cast<R>();
-  return out;
-}
 /// Q_ext(q)'s scalar for applied forces F at a q of Q's scalar.
 template <class F, class Q>
 using applied_scalar_t = typename decltype(std::declval<const F&>().generalized_force(std::declval<const Q&>()))::Scalar;
@@ -75,8 +67,9 @@ void generalized_force_into(const F& fx, const Q& q, Out& out) {
     out = fx.generalized_force(q).template cast<typename Out::Scalar>();
 }
 /// v −= Q_ext(q) (sign −1) or v += Q_ext(q) (sign +1), entry by entry, in v's scalar (which
-/// must hold Q_ext's): the numbers of minus_applied and plus_applied, Q_ext in stack scratch
-/// (beyond 4096 entries, a block the thread keeps) — no allocation where F writes into storage.
+/// must hold Q_ext's), Q_ext in stack scratch (beyond 4096 entries, a block the thread keeps):
+/// no allocation where F writes into storage. The call forms (minus_applied, plus_applied) and
+/// the `evaluate` forms all add Q_ext through it, so they agree bit for bit.
 template <int Sign, class F, class Q, class V>
 void add_applied(const F& fx, const Q& q, Eigen::MatrixBase<V>& v) {
   using R = applied_scalar_t<F, Q>;
@@ -93,12 +86,20 @@ void add_applied(const F& fx, const Q& q, Eigen::MatrixBase<V>& v) {
       v(j) = v(j) + T(Qx(j));
   }
 }
+/// v − Q_ext(q), N entries in the common scalar: what rne returns with applied forces.
+template <int N, class V, class F, class Q>
+auto minus_applied(const V& v, const F& fx, const Q& q) {
+  using R = promote_t<typename V::Scalar, applied_scalar_t<F, Q>>;
+  vecN<R, N> out = v.template cast<R>();
+  add_applied<-1>(fx, q, out);
+  return out;
+}
 /// τ + Q_ext(q) in the common scalar: what the forward dynamics solve for with applied forces.
 template <class Tau, class F, class Q>
 auto plus_applied(const Tau& tau, const F& fx, const Q& q) {
-  const auto Qx = fx.generalized_force(q);
-  using R = promote_t<typename Tau::Scalar, typename decltype(Qx)::Scalar>;
-  vecN<R, dynamic> out = tau.template cast<R>() + Qx.template cast<R>();
+  using R = promote_t<typename Tau::Scalar, applied_scalar_t<F, Q>>;
+  vecN<R, dynamic> out = tau.template cast<R>();
+  add_applied<+1>(fx, q, out);
   return out;
 }
 }  // namespace detail
