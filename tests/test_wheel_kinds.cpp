@@ -603,6 +603,64 @@ TEST_CASE("wheeled_base: 'wheels' = wheeled_base with the same two fixed wheels 
   }
 }
 
+TEST_CASE("wheeled_base: wheels rigid on the base take the closed-form kernel, which gives the general kernel's S, q_ddot, "
+          "tau and lambda", "[wheel_kinds]") {
+  // The general kernel (frames along each wheel's path) runs for any scalar but the model's: a
+  // long-double q (S, the lift) or duals of zero derivative (τ, λ: the same double arithmetic
+  // through every stage) take it on the same model. Both kernels against each other, on bases
+  // that are rigid (mecanum, omni, an axle) and not (castors), with scaled radii.
+  const auto r = load("mobile_manipulator_wheels.json");
+  const wheeled_base<double> axle(r.model, {{wheel_kind::fixed, "wheel_left_joint", "", 0.1},
+                                            {wheel_kind::fixed, "wheel_right_joint", "", 0.1}}, quiet());
+  std::vector<std::pair<std::string, io::robot_model>> models;
+  for (const auto& f : shipped) models.emplace_back(f, load(f));
+  std::mt19937 rng(41);
+  const auto check = [&](const wheeled_base<double>& c, const tree<double>& t) {
+    const auto id = inverse_dynamics_with_forces(t, c);
+    using D = dual<double, 1>;
+    const auto id_general = [&](const VectorXd& q, const VectorXd& eta, const VectorXd& eta_dot) {
+      const auto f = id(q.cast<D>().eval(), eta.cast<D>().eval(), eta_dot.cast<D>().eval());
+      struct {
+        VectorXd tau, lambda;
+      } out{f.tau.unaryExpr([](const D& x) { return x.value(); }), f.lambda.unaryExpr([](const D& x) { return x.value(); })};
+      return out;
+    };
+    const auto relm = [](const MatrixXd& a, const MatrixXd& b) {
+      return (a - b).cwiseAbs().maxCoeff() / (1 + b.cwiseAbs().maxCoeff());
+    };
+    for (int trial = 0; trial < 10; ++trial) {
+      const VectorXd q = random_q(c.dof(), rng), eta = random_vec(c.m(), rng), eta_dot = random_vec(c.m(), rng);
+      const Eigen::Matrix<LD, Eigen::Dynamic, 1> ql = q.cast<LD>();
+      const MatrixXd S = c.S(q);
+      CHECK(relm(S, MatrixXd(c.S(ql).cast<double>())) <= 5e-15);
+      const auto xi = lift(c)(q, eta, eta_dot);
+      const auto xl = lift(c)(ql, eta.cast<LD>().eval(), eta_dot.cast<LD>().eval());
+      CHECK(rel(xi.qd, VectorXd(xl.qd.cast<double>())) <= 5e-15);
+      CHECK(rel(xi.qdd, VectorXd(xl.qdd.cast<double>())) <= 2e-14);
+      // τ and λ then differ from the general kernel's by rounding only, no more than the general
+      // kernel's own double and long-double results differ on the castor bases (the projected
+      // Euler–Lagrange test above checks both against the reference)
+      const auto a = id(q, eta, eta_dot);
+      const auto b = id_general(q, eta, eta_dot);
+      CHECK(rel(a.tau, b.tau) <= 1e-14);
+      CHECK(rel(a.lambda, b.lambda) <= 2e-12);  // λ: up to 6e-13 between double and duals on castor_drive_arm (one kernel)
+    }
+  };
+  for (const auto& [file, m] : models) {
+    INFO(file);
+    const auto& c = base_of(m);
+    CHECK(c.rigid_on_base() == (file == "mecanum_arm.json" || file == "omni3_arm.json"));
+    check(c, m.model);
+    const auto scaled = c.with_radius_factor(1.07);  // the constants follow the radii
+    CHECK(scaled.rigid_on_base() == c.rigid_on_base());
+    check(scaled, m.model);
+    CHECK(c.cast<LD>().rigid_on_base() == c.rigid_on_base());
+  }
+  INFO("the axle");
+  CHECK(axle.rigid_on_base());
+  check(axle, r.model);
+}
+
 TEST_CASE("wheeled_base: an unforced 10 s motion of each shipped base keeps A q_dot = 0 and the energy, whose error falls as RK4's h^4", "[wheel_kinds][long]") {
   for (const auto& file : shipped) {
     INFO(file);

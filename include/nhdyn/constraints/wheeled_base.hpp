@@ -336,6 +336,10 @@ class wheeled_base {
   /// number of independently steerable directions.
   int mobility() const { return mobility_; }
   int steerability() const { return steerability_; }
+  /// Whether every wheel is rigid on a planar base (fixed and swedish wheels on one body that
+  /// slides and turns in the plane): A and Ȧq̇ then take a closed form in ψ, the base's heading
+  /// (docs/theory.md §11; docs/performance.md note 26 measures it).
+  bool rigid_on_base() const { return rigid_yaw_ >= 0; }
   /// A sentence on a base that cannot move or moves only along a line; empty otherwise.
   std::string mobility_note() const {
     if (base_joints_ == 0) return "";
@@ -529,7 +533,10 @@ class wheeled_base {
     // −A_D⁻¹ Ȧ q̇ (in D's order), then q̈: η̇ at η's joints, S_D η̇ − A_D⁻¹ Ȧ q̇ at D's
     const int kk = k();
     detail::wheel_buffer<T, dynamic> b(kk), x(kk);
-    Adot_qdot(f.X.data(), qd, b.data());
+    if (f.rigid)
+      rigid_Adot_qdot(f.yaw, qd, b.data());
+    else
+      Adot_qdot(f.X.data(), qd, b.data());
     f.solve(b.data(), x.data());
     const int mm = m(), mwi = mw();
     for (int c = 0; c < mm; ++c) qdd(eta_[std::size_t(c)]) = T(eta_dot(c));
@@ -606,6 +613,7 @@ class wheeled_base {
     for (const Sc& r : radius_) o.radius_.push_back(U(r));
     for (const Sc& c : cos_gamma_) o.cos_gamma_.push_back(U(c));
     for (const Sc& s : sin_gamma_) o.sin_gamma_.push_back(U(s));
+    o.prepare_rigid();
     return o;
   }
   /// A copy with every wheel's radius multiplied by f > 0 (a plant whose wheels differ from
@@ -615,6 +623,7 @@ class wheeled_base {
     wheeled_base o = *this;
     for (auto& r : o.radius_) r *= Sc(f);
     for (auto& w : o.wheels_) w.radius *= f;
+    o.prepare_rigid();
     return o;
   }
 
@@ -836,6 +845,95 @@ class wheeled_base {
     }
   }
 
+  /// Wheels rigid on a planar base: every node but the spin joints' is one revolute joint ψ (the
+  /// base's heading) and prismatic joints above it (fixed axes a_j in the plane), and every spin
+  /// joint hangs from ψ (fixed and swedish wheels on one body: a mecanum or omni base, an axle).
+  /// Each row's floor direction is then u = R(ψ) u₀ and its contact point turns with it, so A's
+  /// entries are constants but uᵀa_j on the prismatic columns, and Ȧq̇ = ψ̇ (e_z × u)ᵀ Σ a_j q̇_j.
+  /// rows_at and Adot_qdot in closed form (`rigid_rows`, `rigid_Adot_qdot`): the same rows
+  /// (test_wheel_kinds compares the two kernels), in the model's own scalar only (any other —
+  /// duals, intervals, a higher precision — takes the general kernel, which forms the rows in
+  /// its own arithmetic; docs/theory.md §11).
+  template <class T>
+  static constexpr bool rigid_kernel_for = std::is_same_v<T, Sc> && !enclosure_scalar<Sc>;
+  template <class T>
+  bool rigid_for() const {
+    if constexpr (rigid_kernel_for<T>)
+      return rigid_yaw_ >= 0;
+    else
+      return false;
+  }
+  /// A's read columns (k × |W|, column-major into aw; the others zero) when rigid; cs gets
+  /// (cos ψ, sin ψ).
+  template <class T, class Q>
+  void rigid_rows(const Q& q, T* aw, vec2<T>& cs) const {
+    const auto& yaw = plane_[std::size_t(rigid_yaw_)];
+    const auto sc = detail::sincos_of(T(yaw.sign) * T(q(yaw.joint)));
+    cs = vec2<T>(sc.c, sc.s);
+    const int kk = k();
+    for (int i = 0, e = kk * nw(); i < e; ++i) aw[i] = T(0);
+    for (int r = 0; r < kk; ++r) {
+      const vec2<Sc>& u0 = rigid_u0_[std::size_t(r)];
+      const vec2<T> u(sc.c * u0.x() - sc.s * u0.y(), sc.s * u0.x() + sc.c * u0.y());
+      for (const int j : read_paths_[std::size_t(rows_[std::size_t(r)].wheel)]) {
+        const auto& nd = plane_[std::size_t(j)];
+        aw[r + j * kk] = nd.revolute ? T(rigid_a0_[std::size_t(r + j * kk)]) : u.x() * nd.axis.x() + u.y() * nd.axis.y();
+      }
+    }
+  }
+  /// Ȧq̇ (k entries into b) when rigid, at (cos ψ, sin ψ) = cs.
+  template <class T, class QD>
+  void rigid_Adot_qdot(const vec2<T>& cs, const QD& qd, T* b) const {
+    const auto& yaw = plane_[std::size_t(rigid_yaw_)];
+    const T psi_dot = T(yaw.sign) * T(qd(yaw.joint));
+    T vx(0), vy(0);  // Σ a_j q̇_j
+    for (const int j : rigid_prism_) {
+      const auto& nd = plane_[std::size_t(j)];
+      const T qdj = T(qd(nd.joint));
+      vx += nd.axis.x() * qdj, vy += nd.axis.y() * qdj;
+    }
+    for (int r = 0; r < k(); ++r) {
+      const vec2<Sc>& u0 = rigid_u0_[std::size_t(r)];
+      const T ux = cs.x() * u0.x() - cs.y() * u0.y(), uy = cs.y() * u0.x() + cs.x() * u0.y();
+      b[r] = psi_dot * (ux * vy - uy * vx);  // ψ̇ (e_z × u)ᵀ v
+    }
+  }
+  /// Finds whether the wheels are rigid on a planar base and keeps u₀ and A at ψ = 0.
+  void prepare_rigid() {
+    rigid_yaw_ = -1, rigid_prism_.clear(), rigid_u0_.clear(), rigid_a0_.clear();
+    if constexpr (!enclosure_scalar<Sc>) {
+      const int nodes = static_cast<int>(plane_.size());
+      int yaw = -1;
+      for (int i = 0; i < nodes; ++i)
+        if (plane_[std::size_t(i)].revolute && !plane_[std::size_t(i)].spin) {
+          if (yaw >= 0) return;  // two revolute joints: not one rigid body
+          yaw = i;
+        }
+      if (yaw < 0 || k() == 0) return;
+      std::vector<bool> above(std::size_t(nodes), false);
+      for (int p = plane_[std::size_t(yaw)].parent; p >= 0; p = plane_[std::size_t(p)].parent) above[std::size_t(p)] = true;
+      std::vector<int> prism;
+      for (int i = 0; i < nodes; ++i) {
+        const auto& nd = plane_[std::size_t(i)];
+        if (i == yaw) continue;
+        if (above[std::size_t(i)])
+          prism.push_back(i);  // not revolute (the only revolute joint is ψ), not a spin (a spin node has no children)
+        else if (!(nd.spin && nd.parent == yaw))
+          return;
+      }
+      const int kk = k();
+      std::vector<frame2<Sc>> X(std::size_t(nodes), frame2<Sc>{Sc(1), Sc(0), vec2<Sc>::Zero(), vec2<Sc>::Zero()});
+      std::vector<Sc> a0(std::size_t(kk * nw()), Sc(0));
+      rows_at(vecN<Sc, dynamic>(vecN<Sc, dynamic>::Zero(n_)), a0.data(), X.data(), true);
+      for (int r = 0; r < kk; ++r) {
+        const int sn = row_node_[std::size_t(r)], w = rows_[std::size_t(r)].wheel;
+        const floor_frame<Sc> F(X[std::size_t(sn)].a, plane_[std::size_t(sn)].inv_len);
+        rigid_u0_.push_back(F.row(rows_[std::size_t(r)].kind, cos_gamma_[std::size_t(w)], sin_gamma_[std::size_t(w)]));
+      }
+      rigid_a0_ = std::move(a0), rigid_prism_ = std::move(prism), rigid_yaw_ = yaw;
+    }
+  }
+
   /// A at q on the wheels' paths' columns and the block elimination of A_D (refused, naming the
   /// configuration and the wheels, where η does not determine the motion): each wheel's own
   /// dependent joints appear in its own rows only, with coefficients that do not change with q
@@ -845,6 +943,8 @@ class wheeled_base {
   template <class T>
   struct factored {
     const wheeled_base& c;
+    bool rigid;                                ///< the rows in closed form (rigid_rows): X unused, yaw = (cos ψ, sin ψ)
+    vec2<T> yaw = vec2<T>::Zero();
     detail::wheel_buffer<frame2<T>, dynamic> X;
     detail::wheel_buffer<T, dynamic> aw;  ///< A on W's columns, k × |W|
     detail::wheel_buffer<T, dynamic> K;   ///< the base's Schur block, its LU (k_b × k_b)
@@ -857,10 +957,13 @@ class wheeled_base {
 
     template <class Q>
     factored(const wheeled_base& w, const Q& q, bool with_sd)
-        : c(w), X(static_cast<int>(w.plane_.size())), aw(w.k() * w.nw()), K(w.kb_ * w.kb_), perm(w.kb_),
-          H((w.k() - w.kb_) * w.kb_), sd(with_sd ? w.k() * w.mw() : 0) {
+        : c(w), rigid(w.template rigid_for<T>()), X(rigid ? 0 : static_cast<int>(w.plane_.size())), aw(w.k() * w.nw()),
+          K(w.kb_ * w.kb_), perm(w.kb_), H((w.k() - w.kb_) * w.kb_), sd(with_sd ? w.k() * w.mw() : 0) {
       const int k = c.k(), kb = c.kb_;
-      c.rows_at(q, aw.data(), X.data(), false);
+      if (rigid)
+        c.rigid_rows(q, aw.data(), yaw);
+      else
+        c.rows_at(q, aw.data(), X.data(), false);
       const auto A = [&](int r, int col) -> const T& { return aw[r + col * k]; };
       // K: each wheel's rows left after its pivot rows eliminate its own dependent joints;
       // H = Pinv A[P, D_b] of each own dependent joint
@@ -990,14 +1093,25 @@ class wheeled_base {
   template <class Q, class T, class R, class Out>
   void actuation_into(const Q& q, const T* sd, const R& r, Out& tau) const {
     using U = promote_t<T, typename R::Scalar>;
-    const int kk = k(), mw_ = mw(), pw_ = pw();
     const Eigen::Index cols = r.cols();
     for (const auto& [a, c] : act_eta_)
       for (Eigen::Index j = 0; j < cols; ++j) tau(a, j) = U(r(c, j));
-    if (mw_ == 0) {  // the wheels allow no motion: their actuators need no torque
-      for (const auto& aw : actw_) tau.row(aw.first).setZero();
-      return;
+    switch (mw()) {
+      case 0:  // the wheels allow no motion: their actuators need no torque
+        for (const auto& aw : actw_) tau.row(aw.first).setZero();
+        return;
+      case 3:  // a planar base's (ẋ, ẏ, ψ̇): the loops below at a size the compiler knows
+        return wheel_actuation_into<3>(q, sd, r, tau);
+      default:
+        return wheel_actuation_into<dynamic>(q, sd, r, tau);
     }
+  }
+  /// actuation_into's wheel-path block, |η ∩ W| = MW (or dynamic).
+  template <int MW, class Q, class T, class R, class Out>
+  void wheel_actuation_into(const Q& q, const T* sd, const R& r, Out& tau) const {
+    using U = promote_t<T, typename R::Scalar>;
+    const int kk = k(), mw_ = MW == dynamic ? mw() : MW, pw_ = pw();
+    const Eigen::Index cols = r.cols();
     // B(i, a) = S(actuator a's joint, η's wheel-path entry i): a column of S_D, or a unit column
     const bool square = pw_ == mw_;
     detail::wheel_buffer<U, dynamic> buf(mw_ * pw_ + mw_ * mw_ + mw_);  // B, G, x
@@ -1164,6 +1278,12 @@ class wheeled_base {
   std::vector<detail::elim_eq<Sc>> base_eqs_{}, own_eqs_{};
   std::vector<int> Db_{}, Db_pos_{};              ///< the base's dependent joints: W column, position in D
   int kb_ = 0;                                    ///< |Db_|
+  /// Wheels rigid on a planar base (prepare_rigid): ψ's node (−1: the general kernel), the
+  /// prismatic nodes above it, per row u at ψ = 0, A at q = 0 (k × |W|, column-major).
+  int rigid_yaw_ = -1;
+  std::vector<int> rigid_prism_{};
+  std::vector<detail::vec2<Sc>> rigid_u0_{};
+  std::vector<Sc> rigid_a0_{};
   bool act_is_eta_ = false;  ///< the actuators are η's joints in η's order: SᵀE = I
   int mobility_ = 0, steerability_ = 0, base_joints_ = 0;
 };
@@ -1666,6 +1786,7 @@ void wheeled_base<Sc>::build(const tree<Sc>& t, const wheeled_base_options& o) {
       }
     }
   }
+  prepare_rigid();
 }
 
 }  // namespace nhdyn
