@@ -633,6 +633,7 @@ TEST_CASE("wheeled_base: wheels rigid on the base take the closed-form kernel, w
       const Eigen::Matrix<LD, Eigen::Dynamic, 1> ql = q.cast<LD>();
       const MatrixXd S = c.S(q);
       CHECK(relm(S, MatrixXd(c.S(ql).cast<double>())) <= 5e-15);
+      CHECK((c.A(q) * S).cwiseAbs().maxCoeff() <= 1e-13 * (1 + S.cwiseAbs().maxCoeff()));  // with scaled radii too
       const auto xi = lift(c)(q, eta, eta_dot);
       const auto xl = lift(c)(ql, eta.cast<LD>().eval(), eta_dot.cast<LD>().eval());
       CHECK(rel(xi.qd, VectorXd(xl.qd.cast<double>())) <= 5e-15);

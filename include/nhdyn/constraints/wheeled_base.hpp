@@ -617,12 +617,17 @@ class wheeled_base {
     return o;
   }
   /// A copy with every wheel's radius multiplied by f > 0 (a plant whose wheels differ from
-  /// the nominal model's).
+  /// the nominal model's). A spin joint's column of A is −r a × e_z, so a wheel's pivot block
+  /// of its own joints scales by f on its spin column: the inverse's spin row by 1/f (the
+  /// eliminated rows' multipliers A[N, own] Pinv do not change).
   wheeled_base with_radius_factor(double f) const {
     if (!(std::isfinite(f) && f > 0)) throw model_error("wheeled_base: a radius factor must be positive and finite");
     wheeled_base o = *this;
     for (auto& r : o.radius_) r *= Sc(f);
     for (auto& w : o.wheels_) w.radius *= f;
+    for (auto& e : o.own_eqs_)
+      if (plane_[std::size_t(D_[std::size_t(e.row)])].spin)
+        for (int t = 0; t < e.d; ++t) e.coef[t] /= Sc(f);
     o.prepare_rigid();
     return o;
   }
