@@ -603,12 +603,13 @@ TEST_CASE("wheeled_base: 'wheels' = wheeled_base with the same two fixed wheels 
   }
 }
 
-TEST_CASE("wheeled_base: wheels rigid on the base take the closed-form kernel, which gives the general kernel's S, q_ddot, "
-          "tau and lambda", "[wheel_kinds]") {
+TEST_CASE("wheeled_base: wheels on one planar body take the closed-form kernel, which gives the general kernel's S, "
+          "q_ddot, tau and lambda", "[wheel_kinds]") {
   // The general kernel (frames along each wheel's path) runs for any scalar but the model's: a
   // long-double q (S, the lift) or duals of zero derivative (τ, λ: the same double arithmetic
   // through every stage) take it on the same model. Both kernels against each other, on bases
-  // that are rigid (mecanum, omni, an axle) and not (castors), with scaled radii.
+  // whose wheels hang from the body directly (mecanum, omni, an axle) or through swivel joints
+  // (castors), with scaled radii.
   const auto r = load("mobile_manipulator_wheels.json");
   const wheeled_base<double> axle(r.model, {{wheel_kind::fixed, "wheel_left_joint", "", 0.1},
                                             {wheel_kind::fixed, "wheel_right_joint", "", 0.1}}, quiet());
@@ -650,15 +651,15 @@ TEST_CASE("wheeled_base: wheels rigid on the base take the closed-form kernel, w
   for (const auto& [file, m] : models) {
     INFO(file);
     const auto& c = base_of(m);
-    CHECK(c.rigid_on_base() == (file == "mecanum_arm.json" || file == "omni3_arm.json"));
+    CHECK(c.wheels_on_one_body());
     check(c, m.model);
     const auto scaled = c.with_radius_factor(1.07);  // the constants follow the radii
-    CHECK(scaled.rigid_on_base() == c.rigid_on_base());
+    CHECK(scaled.wheels_on_one_body());
     check(scaled, m.model);
-    CHECK(c.cast<LD>().rigid_on_base() == c.rigid_on_base());
+    CHECK(c.cast<LD>().wheels_on_one_body());
   }
   INFO("the axle");
-  CHECK(axle.rigid_on_base());
+  CHECK(axle.wheels_on_one_body());
   check(axle, r.model);
 }
 

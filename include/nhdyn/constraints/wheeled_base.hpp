@@ -336,10 +336,11 @@ class wheeled_base {
   /// number of independently steerable directions.
   int mobility() const { return mobility_; }
   int steerability() const { return steerability_; }
-  /// Whether every wheel is rigid on a planar base (fixed and swedish wheels on one body that
-  /// slides and turns in the plane): A and Ȧq̇ then take a closed form in ψ, the base's heading
-  /// (docs/theory.md §11; docs/performance.md note 26 measures it).
-  bool rigid_on_base() const { return rigid_yaw_ >= 0; }
+  /// Whether every wheel stands on one body that slides and turns in the plane, directly (fixed,
+  /// Swedish) or through its steering or swivel joint (steered, castor): the lift then forms A
+  /// and Ȧq̇ in closed form in the body's heading and the steering angles (docs/theory.md §11;
+  /// docs/performance.md note 26 measures it). Every shipped base does.
+  bool wheels_on_one_body() const { return body_yaw_ >= 0; }
   /// A sentence on a base that cannot move or moves only along a line; empty otherwise.
   std::string mobility_note() const {
     if (base_joints_ == 0) return "";
@@ -533,8 +534,8 @@ class wheeled_base {
     // −A_D⁻¹ Ȧ q̇ (in D's order), then q̈: η̇ at η's joints, S_D η̇ − A_D⁻¹ Ȧ q̇ at D's
     const int kk = k();
     detail::wheel_buffer<T, dynamic> b(kk), x(kk);
-    if (f.rigid)
-      rigid_Adot_qdot(f.yaw, qd, b.data());
+    if (f.body)
+      body_Adot_qdot(q, f.yaw, qd, b.data());
     else
       Adot_qdot(f.X.data(), qd, b.data());
     f.solve(b.data(), x.data());
@@ -613,7 +614,7 @@ class wheeled_base {
     for (const Sc& r : radius_) o.radius_.push_back(U(r));
     for (const Sc& c : cos_gamma_) o.cos_gamma_.push_back(U(c));
     for (const Sc& s : sin_gamma_) o.sin_gamma_.push_back(U(s));
-    o.prepare_rigid();
+    o.prepare_body_kernel();
     return o;
   }
   /// A copy with every wheel's radius multiplied by f > 0 (a plant whose wheels differ from
@@ -628,7 +629,7 @@ class wheeled_base {
     for (auto& e : o.own_eqs_)
       if (plane_[std::size_t(D_[std::size_t(e.row)])].spin)
         for (int t = 0; t < e.d; ++t) e.coef[t] /= Sc(f);
-    o.prepare_rigid();
+    o.prepare_body_kernel();
     return o;
   }
 
@@ -850,92 +851,147 @@ class wheeled_base {
     }
   }
 
-  /// Wheels rigid on a planar base: every node but the spin joints' is one revolute joint ψ (the
-  /// base's heading) and prismatic joints above it (fixed axes a_j in the plane), and every spin
-  /// joint hangs from ψ (fixed and swedish wheels on one body: a mecanum or omni base, an axle).
-  /// Each row's floor direction is then u = R(ψ) u₀ and its contact point turns with it, so A's
-  /// entries are constants but uᵀa_j on the prismatic columns, and Ȧq̇ = ψ̇ (e_z × u)ᵀ Σ a_j q̇_j.
-  /// rows_at and Adot_qdot in closed form (`rigid_rows`, `rigid_Adot_qdot`): the same rows
-  /// (test_wheel_kinds compares the two kernels), in the model's own scalar only (any other —
-  /// duals, intervals, a higher precision — takes the general kernel, which forms the rows in
-  /// its own arithmetic; docs/theory.md §11).
+  /// Wheels on one planar body: the nodes are prismatic joints with fixed axes a_j, one revolute
+  /// joint ψ below them (the body's heading, sign s_ψ), and per wheel its spin joint, hanging
+  /// from ψ directly (fixed, Swedish) or through one steering or swivel joint β (steered,
+  /// castor). A row's floor direction is then u = R(ψ + β) u₀ and its contact point's offset
+  /// from ψ's origin R(ψ)(d_β + R(β) d_w), so its entries are constants except
+  ///   (R(ψ + β) u₀)·a_j on a prismatic column, s_ψ (R(β) u₀)·(e_z × d_β) + const on ψ's,
+  /// and Ȧq̇ = (ψ̇ + β̇) (e_z × u)·Σ a_j q̇_j + s_ψ q̇_ψ β̇ (R(β) u₀)·d_β (β, d_β zero for a wheel
+  /// without a steering joint). rows_at and Adot_qdot in closed form (`body_rows`,
+  /// `body_Adot_qdot`; docs/theory.md §11), in the model's own scalar only: any other — duals,
+  /// intervals, a higher precision — takes the general kernel, which forms every constant in
+  /// its own arithmetic (test_wheel_kinds holds the two to each other).
   template <class T>
-  static constexpr bool rigid_kernel_for = std::is_same_v<T, Sc> && !enclosure_scalar<Sc>;
+  static constexpr bool body_kernel_for = std::is_same_v<T, Sc> && !enclosure_scalar<Sc>;
   template <class T>
-  bool rigid_for() const {
-    if constexpr (rigid_kernel_for<T>)
-      return rigid_yaw_ >= 0;
+  bool body_kernel() const {
+    if constexpr (body_kernel_for<T>)
+      return body_yaw_ >= 0;
     else
       return false;
   }
-  /// A's read columns (k × |W|, column-major into aw; the others zero) when rigid; cs gets
+  /// (cos, sin) of a revolute node's signed angle at q.
+  template <class T, class Q>
+  vec2<T> turn_of(int node, const Q& q) const {
+    const auto& nd = plane_[std::size_t(node)];
+    const auto sc = detail::sincos_of(T(nd.sign) * T(q(nd.joint)));
+    return vec2<T>(sc.c, sc.s);
+  }
+  /// v turned by the angle whose (cos, sin) is cs.
+  template <class T, class V>
+  static vec2<T> rotate(const vec2<T>& cs, const V& v) {
+    return vec2<T>(cs.x() * v.x() - cs.y() * v.y(), cs.y() * v.x() + cs.x() * v.y());
+  }
+  /// A's read columns (k × |W|, column-major into aw; the others zero) on one body; cs gets
   /// (cos ψ, sin ψ).
   template <class T, class Q>
-  void rigid_rows(const Q& q, T* aw, vec2<T>& cs) const {
-    const auto& yaw = plane_[std::size_t(rigid_yaw_)];
-    const auto sc = detail::sincos_of(T(yaw.sign) * T(q(yaw.joint)));
-    cs = vec2<T>(sc.c, sc.s);
+  void body_rows(const Q& q, T* aw, vec2<T>& cs) const {
+    cs = turn_of<T>(body_yaw_, q);
+    const T s_yaw = T(plane_[std::size_t(body_yaw_)].sign);
     const int kk = k();
     for (int i = 0, e = kk * nw(); i < e; ++i) aw[i] = T(0);
-    for (int r = 0; r < kk; ++r) {
-      const vec2<Sc>& u0 = rigid_u0_[std::size_t(r)];
-      const vec2<T> u(sc.c * u0.x() - sc.s * u0.y(), sc.s * u0.x() + sc.c * u0.y());
+    vec2<T> beta(T(1), T(0));
+    for (int r = 0, last = -1; r < kk; ++r) {
+      const int st = body_steer_[std::size_t(r)];
+      if (st >= 0 && st != last) beta = turn_of<T>(st, q), last = st;  // a wheel's rows are consecutive
+      const vec2<Sc>& u0 = body_u0_[std::size_t(r)];
+      const vec2<T> ub = st >= 0 ? rotate(beta, u0) : vec2<T>(T(u0.x()), T(u0.y()));
+      const vec2<T> u = rotate(cs, ub);
       for (const int j : read_paths_[std::size_t(rows_[std::size_t(r)].wheel)]) {
         const auto& nd = plane_[std::size_t(j)];
-        aw[r + j * kk] = nd.revolute ? T(rigid_a0_[std::size_t(r + j * kk)]) : u.x() * nd.axis.x() + u.y() * nd.axis.y();
+        T& a = aw[r + j * kk];
+        if (!nd.revolute)
+          a = u.x() * nd.axis.x() + u.y() * nd.axis.y();
+        else if (j == body_yaw_ && st >= 0)
+          a = s_yaw * (ub.y() * body_ds_[std::size_t(r)].x() - ub.x() * body_ds_[std::size_t(r)].y()) + T(body_c_[std::size_t(r)]);  // s_ψ ub·(e_z × d_β) + const
+        else
+          a = T(body_a0_[std::size_t(r + j * kk)]);
       }
     }
   }
-  /// Ȧq̇ (k entries into b) when rigid, at (cos ψ, sin ψ) = cs.
-  template <class T, class QD>
-  void rigid_Adot_qdot(const vec2<T>& cs, const QD& qd, T* b) const {
-    const auto& yaw = plane_[std::size_t(rigid_yaw_)];
-    const T psi_dot = T(yaw.sign) * T(qd(yaw.joint));
+  /// Ȧq̇ (k entries into b) on one body, at (cos ψ, sin ψ) = cs.
+  template <class T, class Q, class QD>
+  void body_Adot_qdot(const Q& q, const vec2<T>& cs, const QD& qd, T* b) const {
+    const auto& yaw = plane_[std::size_t(body_yaw_)];
+    const T qd_yaw = T(qd(yaw.joint)), psi_dot = T(yaw.sign) * qd_yaw;
     T vx(0), vy(0);  // Σ a_j q̇_j
-    for (const int j : rigid_prism_) {
+    for (const int j : body_prism_) {
       const auto& nd = plane_[std::size_t(j)];
       const T qdj = T(qd(nd.joint));
       vx += nd.axis.x() * qdj, vy += nd.axis.y() * qdj;
     }
-    for (int r = 0; r < k(); ++r) {
-      const vec2<Sc>& u0 = rigid_u0_[std::size_t(r)];
-      const T ux = cs.x() * u0.x() - cs.y() * u0.y(), uy = cs.y() * u0.x() + cs.x() * u0.y();
-      b[r] = psi_dot * (ux * vy - uy * vx);  // ψ̇ (e_z × u)ᵀ v
+    vec2<T> beta(T(1), T(0));
+    for (int r = 0, last = -1; r < k(); ++r) {
+      const int st = body_steer_[std::size_t(r)];
+      if (st < 0) {
+        const vec2<T> u = rotate(cs, body_u0_[std::size_t(r)]);
+        b[r] = psi_dot * (u.x() * vy - u.y() * vx);  // ψ̇ (e_z × u)·v
+        continue;
+      }
+      if (st != last) beta = turn_of<T>(st, q), last = st;
+      const auto& sn = plane_[std::size_t(st)];
+      const T beta_dot = T(sn.sign) * T(qd(sn.joint));
+      const vec2<T> ub = rotate(beta, body_u0_[std::size_t(r)]), u = rotate(cs, ub);
+      const vec2<Sc>& ds = body_ds_[std::size_t(r)];
+      b[r] = (psi_dot + beta_dot) * (u.x() * vy - u.y() * vx) +
+             T(yaw.sign) * qd_yaw * beta_dot * (ub.x() * ds.x() + ub.y() * ds.y());
     }
   }
-  /// Finds whether the wheels are rigid on a planar base and keeps u₀ and A at ψ = 0.
-  void prepare_rigid() {
-    rigid_yaw_ = -1, rigid_prism_.clear(), rigid_u0_.clear(), rigid_a0_.clear();
+  /// Finds whether the wheels stand on one planar body (body_rows) and keeps, per row, u₀, the
+  /// steering node, d_β and the constant part of ψ's column, and A at q = 0.
+  void prepare_body_kernel() {
+    body_yaw_ = -1, body_prism_.clear(), body_u0_.clear(), body_a0_.clear(), body_steer_.clear(), body_ds_.clear(),
+    body_c_.clear();
     if constexpr (!enclosure_scalar<Sc>) {
       const int nodes = static_cast<int>(plane_.size());
+      const auto revolute = [&](int i) { return plane_[std::size_t(i)].revolute && !plane_[std::size_t(i)].spin; };
+      // ψ: the one revolute node with no revolute node above it
       int yaw = -1;
-      for (int i = 0; i < nodes; ++i)
-        if (plane_[std::size_t(i)].revolute && !plane_[std::size_t(i)].spin) {
-          if (yaw >= 0) return;  // two revolute joints: not one rigid body
-          yaw = i;
-        }
+      for (int i = 0; i < nodes; ++i) {
+        if (!revolute(i)) continue;
+        bool top = true;
+        for (int p = plane_[std::size_t(i)].parent; p >= 0; p = plane_[std::size_t(p)].parent) top = top && !revolute(p);
+        if (!top) continue;
+        if (yaw >= 0) return;  // two bodies turning independently
+        yaw = i;
+      }
       if (yaw < 0 || k() == 0) return;
       std::vector<bool> above(std::size_t(nodes), false);
       for (int p = plane_[std::size_t(yaw)].parent; p >= 0; p = plane_[std::size_t(p)].parent) above[std::size_t(p)] = true;
       std::vector<int> prism;
       for (int i = 0; i < nodes; ++i) {
         const auto& nd = plane_[std::size_t(i)];
+        const int par = nd.parent;
         if (i == yaw) continue;
         if (above[std::size_t(i)])
-          prism.push_back(i);  // not revolute (the only revolute joint is ψ), not a spin (a spin node has no children)
-        else if (!(nd.spin && nd.parent == yaw))
+          prism.push_back(i);  // prismatic: the only revolute node above ψ would be a second top one
+        else if (nd.spin && (par == yaw || (par >= 0 && revolute(par) && plane_[std::size_t(par)].parent == yaw)))
+          continue;  // a wheel on the body, or below its steering joint
+        else if (revolute(i) && par == yaw)
+          continue;  // a steering or swivel joint (its children checked as spins above)
+        else
           return;
       }
       const int kk = k();
       std::vector<frame2<Sc>> X(std::size_t(nodes), frame2<Sc>{Sc(1), Sc(0), vec2<Sc>::Zero(), vec2<Sc>::Zero()});
       std::vector<Sc> a0(std::size_t(kk * nw()), Sc(0));
       rows_at(vecN<Sc, dynamic>(vecN<Sc, dynamic>::Zero(n_)), a0.data(), X.data(), true);
+      const Sc s_yaw = plane_[std::size_t(yaw)].sign;
       for (int r = 0; r < kk; ++r) {
-        const int sn = row_node_[std::size_t(r)], w = rows_[std::size_t(r)].wheel;
+        const int sn = row_node_[std::size_t(r)], w = rows_[std::size_t(r)].wheel, par = plane_[std::size_t(sn)].parent;
         const floor_frame<Sc> F(X[std::size_t(sn)].a, plane_[std::size_t(sn)].inv_len);
-        rigid_u0_.push_back(F.row(rows_[std::size_t(r)].kind, cos_gamma_[std::size_t(w)], sin_gamma_[std::size_t(w)]));
+        const vec2<Sc> u0 = F.row(rows_[std::size_t(r)].kind, cos_gamma_[std::size_t(w)], sin_gamma_[std::size_t(w)]);
+        body_u0_.push_back(u0);
+        if (par == yaw) {
+          body_steer_.push_back(-1), body_ds_.push_back(vec2<Sc>::Zero()), body_c_.push_back(Sc(0));
+        } else {  // ψ's column at q = 0 is s_ψ u₀·(e_z × d_β) + the constant part
+          const vec2<Sc> ds = X[std::size_t(par)].o - X[std::size_t(yaw)].o;
+          body_steer_.push_back(par), body_ds_.push_back(ds);
+          body_c_.push_back(a0[std::size_t(r + yaw * kk)] - s_yaw * u0.dot(perp(ds)));
+        }
       }
-      rigid_a0_ = std::move(a0), rigid_prism_ = std::move(prism), rigid_yaw_ = yaw;
+      body_a0_ = std::move(a0), body_prism_ = std::move(prism), body_yaw_ = yaw;
     }
   }
 
@@ -948,7 +1004,7 @@ class wheeled_base {
   template <class T>
   struct factored {
     const wheeled_base& c;
-    bool rigid;                                ///< the rows in closed form (rigid_rows): X unused, yaw = (cos ψ, sin ψ)
+    bool body;                                 ///< the rows in closed form (body_rows): X unused, yaw = (cos ψ, sin ψ)
     vec2<T> yaw = vec2<T>::Zero();
     detail::wheel_buffer<frame2<T>, dynamic> X;
     detail::wheel_buffer<T, dynamic> aw;  ///< A on W's columns, k × |W|
@@ -962,11 +1018,11 @@ class wheeled_base {
 
     template <class Q>
     factored(const wheeled_base& w, const Q& q, bool with_sd)
-        : c(w), rigid(w.template rigid_for<T>()), X(rigid ? 0 : static_cast<int>(w.plane_.size())), aw(w.k() * w.nw()),
+        : c(w), body(w.template body_kernel<T>()), X(body ? 0 : static_cast<int>(w.plane_.size())), aw(w.k() * w.nw()),
           K(w.kb_ * w.kb_), perm(w.kb_), H((w.k() - w.kb_) * w.kb_), sd(with_sd ? w.k() * w.mw() : 0) {
       const int k = c.k(), kb = c.kb_;
-      if (rigid)
-        c.rigid_rows(q, aw.data(), yaw);
+      if (body)
+        c.body_rows(q, aw.data(), yaw);
       else
         c.rows_at(q, aw.data(), X.data(), false);
       const auto A = [&](int r, int col) -> const T& { return aw[r + col * k]; };
@@ -1283,12 +1339,13 @@ class wheeled_base {
   std::vector<detail::elim_eq<Sc>> base_eqs_{}, own_eqs_{};
   std::vector<int> Db_{}, Db_pos_{};              ///< the base's dependent joints: W column, position in D
   int kb_ = 0;                                    ///< |Db_|
-  /// Wheels rigid on a planar base (prepare_rigid): ψ's node (−1: the general kernel), the
-  /// prismatic nodes above it, per row u at ψ = 0, A at q = 0 (k × |W|, column-major).
-  int rigid_yaw_ = -1;
-  std::vector<int> rigid_prism_{};
-  std::vector<detail::vec2<Sc>> rigid_u0_{};
-  std::vector<Sc> rigid_a0_{};
+  /// Wheels on one planar body (prepare_body_kernel): ψ's node (−1: the general kernel), the
+  /// prismatic nodes above it; per row u at q = 0, its steering node (or −1), d_β and the
+  /// constant part of ψ's column; A at q = 0 (k × |W|, column-major).
+  int body_yaw_ = -1;
+  std::vector<int> body_prism_{}, body_steer_{};
+  std::vector<detail::vec2<Sc>> body_u0_{}, body_ds_{};
+  std::vector<Sc> body_c_{}, body_a0_{};
   bool act_is_eta_ = false;  ///< the actuators are η's joints in η's order: SᵀE = I
   int mobility_ = 0, steerability_ = 0, base_joints_ = 0;
 };
@@ -1791,7 +1848,7 @@ void wheeled_base<Sc>::build(const tree<Sc>& t, const wheeled_base_options& o) {
       }
     }
   }
-  prepare_rigid();
+  prepare_body_kernel();
 }
 
 }  // namespace nhdyn
