@@ -12,6 +12,8 @@
 ///   of each shipped base keeps |A q̇| at rounding level and its energy (error falling as RK4's h⁴);
 /// - a mecanum base turns its wheels at the textbook mecanum rates (Lynch and Park, eq. 13.10);
 /// - `wheels` = `wheeled_base` with the same two fixed wheels (τ, λ, η̇ to 1e-12);
+/// - the closed-form rows of wheels on one body = the general kernel (S, q̈, τ, λ), also with
+///   scaled radii (A S = 0);
 /// - inverse_dynamics' `evaluate` into a reused τ = the composition's τ bit for bit, for every
 ///   robot file's constraint (the two paths share the stages, not the storage);
 /// - rank, mobility and the errors: coaxial rows kept once, skid-steer and immobile bases
@@ -645,7 +647,7 @@ TEST_CASE("wheeled_base: wheels on one planar body take the closed-form kernel, 
       const auto a = id(q, eta, eta_dot);
       const auto b = id_general(q, eta, eta_dot);
       CHECK(rel(a.tau, b.tau) <= 1e-14);
-      CHECK(rel(a.lambda, b.lambda) <= 2e-12);  // λ: up to 6e-13 between double and duals on castor_drive_arm (one kernel)
+      CHECK(rel(a.lambda, b.lambda) <= 2e-12);  // λ: 6e-13 between double and duals on castor_drive_arm with one kernel on both sides
     }
   };
   for (const auto& [file, m] : models) {
