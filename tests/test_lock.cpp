@@ -528,7 +528,9 @@ TEST_CASE("lock: on the mobile manipulator, locking joints equals the URDF loade
 namespace {
 /// The locked robot file's τ (kept actuators), λ and forward dynamics equal the full one's,
 /// with the locked joints at their positions and at rest.
-void check_locked_robot(const io::robot_model& full, const io::robot_model& r, std::uint64_t seed, double lambda_tol = 1e-12) {
+/// λ to 1e-11 by default: the two models' λ differ by rounding, up to 1.2e-12 relative on
+/// castor_drive_arm (seed 35) since the lift's closed-form rows (theory.md §11).
+void check_locked_robot(const io::robot_model& full, const io::robot_model& r, std::uint64_t seed, double lambda_tol = 1e-11) {
   const auto& cf = std::get<wheeled_base<double>>(*full.constraint);
   const auto& cr = std::get<wheeled_base<double>>(*r.constraint);
   const auto jf = full.model.joint_names(), jr = r.model.joint_names();
