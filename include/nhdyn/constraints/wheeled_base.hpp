@@ -535,7 +535,7 @@ class wheeled_base {
     const int kk = k();
     detail::wheel_buffer<T, dynamic> b(kk), x(kk);
     if (f.body)
-      body_Adot_qdot(q, f.yaw, qd, b.data());
+      body_Adot_qdot(f.yaw, f.ub.data(), qd, b.data());
     else
       Adot_qdot(f.X.data(), qd, b.data());
     f.solve(b.data(), x.data());
@@ -884,9 +884,9 @@ class wheeled_base {
     return vec2<T>(cs.x() * v.x() - cs.y() * v.y(), cs.y() * v.x() + cs.x() * v.y());
   }
   /// A's read columns (k × |W|, column-major into aw; the others zero) on one body; cs gets
-  /// (cos ψ, sin ψ).
+  /// (cos ψ, sin ψ) and ub (k entries) each row's R(β) u₀, for body_Adot_qdot.
   template <class T, class Q>
-  void body_rows(const Q& q, T* aw, vec2<T>& cs) const {
+  void body_rows(const Q& q, T* aw, vec2<T>& cs, vec2<T>* ub_rows) const {
     cs = turn_of<T>(body_yaw_, q);
     const T s_yaw = T(plane_[std::size_t(body_yaw_)].sign);
     const int kk = k();
@@ -898,6 +898,7 @@ class wheeled_base {
       const vec2<Sc>& u0 = body_u0_[std::size_t(r)];
       const vec2<T> ub = st >= 0 ? rotate(beta, u0) : vec2<T>(T(u0.x()), T(u0.y()));
       const vec2<T> u = rotate(cs, ub);
+      ub_rows[r] = ub;
       for (const int j : read_paths_[std::size_t(rows_[std::size_t(r)].wheel)]) {
         const auto& nd = plane_[std::size_t(j)];
         T& a = aw[r + j * kk];
@@ -910,9 +911,9 @@ class wheeled_base {
       }
     }
   }
-  /// Ȧq̇ (k entries into b) on one body, at (cos ψ, sin ψ) = cs.
-  template <class T, class Q, class QD>
-  void body_Adot_qdot(const Q& q, const vec2<T>& cs, const QD& qd, T* b) const {
+  /// Ȧq̇ (k entries into b) on one body, at (cos ψ, sin ψ) = cs and body_rows' R(β) u₀ per row.
+  template <class T, class QD>
+  void body_Adot_qdot(const vec2<T>& cs, const vec2<T>* ub_rows, const QD& qd, T* b) const {
     const auto& yaw = plane_[std::size_t(body_yaw_)];
     const T qd_yaw = T(qd(yaw.joint)), psi_dot = T(yaw.sign) * qd_yaw;
     T vx(0), vy(0);  // Σ a_j q̇_j
@@ -921,18 +922,16 @@ class wheeled_base {
       const T qdj = T(qd(nd.joint));
       vx += nd.axis.x() * qdj, vy += nd.axis.y() * qdj;
     }
-    vec2<T> beta(T(1), T(0));
-    for (int r = 0, last = -1; r < k(); ++r) {
+    for (int r = 0; r < k(); ++r) {
       const int st = body_steer_[std::size_t(r)];
+      const vec2<T>& ub = ub_rows[r];
+      const vec2<T> u = rotate(cs, ub);
       if (st < 0) {
-        const vec2<T> u = rotate(cs, body_u0_[std::size_t(r)]);
         b[r] = psi_dot * (u.x() * vy - u.y() * vx);  // ψ̇ (e_z × u)·v
         continue;
       }
-      if (st != last) beta = turn_of<T>(st, q), last = st;
       const auto& sn = plane_[std::size_t(st)];
       const T beta_dot = T(sn.sign) * T(qd(sn.joint));
-      const vec2<T> ub = rotate(beta, body_u0_[std::size_t(r)]), u = rotate(cs, ub);
       const vec2<Sc>& ds = body_ds_[std::size_t(r)];
       b[r] = (psi_dot + beta_dot) * (u.x() * vy - u.y() * vx) +
              T(yaw.sign) * qd_yaw * beta_dot * (ub.x() * ds.x() + ub.y() * ds.y());
@@ -1006,6 +1005,7 @@ class wheeled_base {
     const wheeled_base& c;
     bool body;                                 ///< the rows in closed form (body_rows): X unused, yaw = (cos ψ, sin ψ)
     vec2<T> yaw = vec2<T>::Zero();
+    detail::wheel_buffer<vec2<T>, dynamic> ub;  ///< body_rows' R(β) u₀ per row (k; empty if not body)
     detail::wheel_buffer<frame2<T>, dynamic> X;
     detail::wheel_buffer<T, dynamic> aw;  ///< A on W's columns, k × |W|
     detail::wheel_buffer<T, dynamic> K;   ///< the base's Schur block, its LU (k_b × k_b)
@@ -1018,11 +1018,12 @@ class wheeled_base {
 
     template <class Q>
     factored(const wheeled_base& w, const Q& q, bool with_sd)
-        : c(w), body(w.template body_kernel<T>()), X(body ? 0 : static_cast<int>(w.plane_.size())), aw(w.k() * w.nw()),
+        : c(w), body(w.template body_kernel<T>()), ub(body ? w.k() : 0), X(body ? 0 : static_cast<int>(w.plane_.size())),
+          aw(w.k() * w.nw()),
           K(w.kb_ * w.kb_), perm(w.kb_), H((w.k() - w.kb_) * w.kb_), sd(with_sd ? w.k() * w.mw() : 0) {
       const int k = c.k(), kb = c.kb_;
       if (body)
-        c.body_rows(q, aw.data(), yaw);
+        c.body_rows(q, aw.data(), yaw, ub.data());
       else
         c.rows_at(q, aw.data(), X.data(), false);
       const auto A = [&](int r, int col) -> const T& { return aw[r + col * k]; };
