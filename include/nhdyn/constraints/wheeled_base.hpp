@@ -941,7 +941,7 @@ class wheeled_base {
   /// steering node, d_β and the constant part of ψ's column, and A at q = 0.
   void prepare_body_kernel() {
     body_yaw_ = -1, body_prism_.clear(), body_u0_.clear(), body_a0_.clear(), body_steer_.clear(), body_ds_.clear(),
-    body_c_.clear();
+    body_c_.clear(), body_kinv_.clear(), body_kpos_ = {-1, -1};
     if constexpr (!enclosure_scalar<Sc>) {
       const int nodes = static_cast<int>(plane_.size());
       const auto revolute = [&](int i) { return plane_[std::size_t(i)].revolute && !plane_[std::size_t(i)].spin; };
@@ -991,7 +991,75 @@ class wheeled_base {
         }
       }
       body_a0_ = std::move(a0), body_prism_ = std::move(prism), body_yaw_ = yaw;
+      prepare_body_base_block();
     }
+  }
+  /// When the base's rows (base_eqs_) come from wheels without a steering joint, each is
+  /// ũᵀR(ψ)ᵀa_j on a prismatic column and constant on every other (body_rows), so the base's
+  /// Schur block is K(ψ) = K₀ T(ψ): T is the identity but on the base's two prismatic columns,
+  /// where it is Paᵀ R(ψ)ᵀ Pa (Pa = [a₁ a₂], their orthonormal floor axes). K₀ is factored
+  /// here, once: x_b = T⁻¹ K₀⁻¹ b' at each q (body_base_solve) instead of an LU of K. T is
+  /// orthogonal, so K's conditioning does not change with ψ: a K₀ well inside the singularity
+  /// test (100× its tolerance) leaves every K(ψ) determined; a K₀ nearer keeps the per-q LU.
+  void prepare_body_base_block() {
+    body_kinv_.clear(), body_kpos_ = {-1, -1};
+    const int kb = kb_, kk = k();
+    if (kb == 0) return;
+    for (const auto& e : base_eqs_) {
+      if (body_steer_[std::size_t(e.row)] >= 0) return;
+      for (int t = 0; t < e.d; ++t)
+        if (body_steer_[std::size_t(e.P[t])] >= 0) return;
+    }
+    int found = 0;
+    for (int j = 0; j < kb; ++j)
+      for (std::size_t i = 0; i < body_prism_.size(); ++i)
+        if (Db_[std::size_t(j)] == body_prism_[i]) {
+          if (body_prism_.size() != 2) return;
+          body_kpos_[i] = j, ++found;
+        }
+    if (found == 1) return;
+    if (found == 2) {
+      const vec2<Sc>&a1 = plane_[std::size_t(body_prism_[0])].axis, &a2 = plane_[std::size_t(body_prism_[1])].axis;
+      using std::abs;
+      if (!(abs(a1.dot(a1) - 1) < Sc(1e-12) && abs(a2.dot(a2) - 1) < Sc(1e-12) && abs(a1.dot(a2)) < Sc(1e-12)))
+        return body_kpos_ = {-1, -1}, void();  // not two orthonormal axes
+    }
+    std::vector<Sc> K(static_cast<std::size_t>(kb * kb)), inv(static_cast<std::size_t>(kb * kb), Sc(0));
+    std::vector<int> perm(static_cast<std::size_t>(kb));
+    for (int j = 0; j < kb; ++j)
+      for (int r = 0; r < kb; ++r) {
+        const auto& e = base_eqs_[std::size_t(r)];
+        const Sc* col = body_a0_.data() + Db_[std::size_t(j)] * kk;
+        Sc x = col[e.row];
+        for (int t = 0; t < e.d; ++t) x -= e.coef[t] * col[e.P[t]];
+        K[std::size_t(r + j * kb)] = x;
+      }
+    if (detail::lu_in_place(K.data(), kb, perm.data()) < 100 * singular_tolerance) return body_kpos_ = {-1, -1}, void();
+    for (int j = 0; j < kb; ++j) {
+      inv[std::size_t(j + j * kb)] = Sc(1);
+      detail::lu_solve(K.data(), perm.data(), kb, inv.data() + j * kb);
+    }
+    body_kinv_ = std::move(inv);
+  }
+  /// x_b = K(ψ)⁻¹ b' in place (kb entries) by K₀⁻¹ and T(ψ)⁻¹ (prepare_body_base_block), at
+  /// (cos ψ, sin ψ) = cs.
+  template <int KB, class T>
+  void body_base_solve(const vec2<T>& cs, T* x) const {
+    const int kb = KB == dynamic ? kb_ : KB;
+    detail::wheel_buffer<T, KB> y(kb);
+    for (int r = 0; r < kb; ++r) {
+      T a(0);
+      for (int i = 0; i < kb; ++i) a += T(body_kinv_[std::size_t(r + i * kb)]) * x[i];
+      y[r] = a;
+    }
+    if (const int p = body_kpos_[0], s = body_kpos_[1]; p >= 0) {  // [x_p; x_s] = Paᵀ R(ψ) Pa [y_p; y_s]
+      const auto& a1 = plane_[std::size_t(body_prism_[0])].axis;
+      const auto& a2 = plane_[std::size_t(body_prism_[1])].axis;
+      const vec2<T> v = rotate(cs, vec2<T>(y[p] * T(a1.x()) + y[s] * T(a2.x()), y[p] * T(a1.y()) + y[s] * T(a2.y())));
+      y[p] = T(a1.x()) * v.x() + T(a1.y()) * v.y();
+      y[s] = T(a2.x()) * v.x() + T(a2.y()) * v.y();
+    }
+    for (int r = 0; r < kb; ++r) x[r] = y[r];
   }
 
   /// A at q on the wheels' paths' columns and the block elimination of A_D (refused, naming the
@@ -1004,6 +1072,7 @@ class wheeled_base {
   struct factored {
     const wheeled_base& c;
     bool body;                                 ///< the rows in closed form (body_rows): X unused, yaw = (cos ψ, sin ψ)
+    bool fixed_k;                              ///< K = K₀ T(ψ) (body_base_solve): K and perm unused
     vec2<T> yaw = vec2<T>::Zero();
     detail::wheel_buffer<vec2<T>, dynamic> ub;  ///< body_rows' R(β) u₀ per row (k; empty if not body)
     detail::wheel_buffer<frame2<T>, dynamic> X;
@@ -1018,9 +1087,9 @@ class wheeled_base {
 
     template <class Q>
     factored(const wheeled_base& w, const Q& q, bool with_sd)
-        : c(w), body(w.template body_kernel<T>()), ub(body ? w.k() : 0), X(body ? 0 : static_cast<int>(w.plane_.size())),
-          aw(w.k() * w.nw()),
-          K(w.kb_ * w.kb_), perm(w.kb_), H((w.k() - w.kb_) * w.kb_), sd(with_sd ? w.k() * w.mw() : 0) {
+        : c(w), body(w.template body_kernel<T>()), fixed_k(body && !w.body_kinv_.empty()), ub(body ? w.k() : 0),
+          X(body ? 0 : static_cast<int>(w.plane_.size())), aw(w.k() * w.nw()), K(fixed_k ? 0 : w.kb_ * w.kb_),
+          perm(fixed_k ? 0 : w.kb_), H((w.k() - w.kb_) * w.kb_), sd(with_sd ? w.k() * w.mw() : 0) {
       const int k = c.k(), kb = c.kb_;
       if (body)
         c.body_rows(q, aw.data(), yaw, ub.data());
@@ -1031,7 +1100,7 @@ class wheeled_base {
       // H = Pinv A[P, D_b] of each own dependent joint
       for (int j = 0; j < kb; ++j) {
         const T* col = aw.data() + c.Db_[std::size_t(j)] * k;
-        for (int r = 0; r < kb; ++r) {
+        for (int r = 0; r < kb && !fixed_k; ++r) {
           const auto& e = c.base_eqs_[std::size_t(r)];
           T x = col[e.row];
           for (int t = 0; t < e.d; ++t) x -= T(e.coef[t]) * col[e.P[t]];
@@ -1045,7 +1114,8 @@ class wheeled_base {
         }
       }
       if constexpr (enclosure_scalar<T>) precondition();
-      if (kb > 0 && detail::lu_in_place(K.data(), kb, perm.data()) < singular_tolerance) c.throw_undetermined(q, aw.data());
+      if (kb > 0 && !fixed_k && detail::lu_in_place(K.data(), kb, perm.data()) < singular_tolerance)
+        c.throw_undetermined(q, aw.data());
       if (with_sd) {
         if (kb == 0) {  // every dependent joint a wheel's own: S_D(o, i) = −Σ Pinv A(P, I_i)
           for (int i = 0; i < c.mw(); ++i) {
@@ -1069,17 +1139,29 @@ class wheeled_base {
             if (!is_finite_scalar(sd[j])) c.throw_not_solved(j % k, "velocities");
       }
     }
-    /// x = A_D⁻¹ b (b: k entries in A's row order; x: k entries in D's order).
+    /// x = A_D⁻¹ b (b: k entries in A's row order; x: k entries in D's order). A planar base's
+    /// three dependent velocities (x, y, ψ) at a compile-time size, any other count at run time.
     void solve(const T* b, T* x) const {
-      const int k = c.k(), kb = c.kb_;
-      detail::wheel_buffer<T, dynamic> bb(kb);
+      if (c.kb_ == 3)
+        solve_n<3>(b, x);
+      else
+        solve_n<dynamic>(b, x);
+    }
+
+   private:
+    template <int KB>
+    void solve_n(const T* b, T* x) const {
+      const int k = c.k(), kb = KB == dynamic ? c.kb_ : KB;
+      detail::wheel_buffer<T, KB> bb(kb);
       for (int r = 0; r < kb; ++r) {
         const auto& e = c.base_eqs_[std::size_t(r)];
         T y = b[e.row];
         for (int t = 0; t < e.d; ++t) y -= T(e.coef[t]) * b[e.P[t]];
         bb[r] = y;
       }
-      if (kb > 0) {
+      if (fixed_k)
+        c.template body_base_solve<KB>(yaw, bb.data());
+      else if (kb > 0) {
         if (C.size()) {
           detail::wheel_buffer<T, dynamic> t(kb);
           for (int r = 0; r < kb; ++r) {
@@ -1100,8 +1182,6 @@ class wheeled_base {
         x[e.row] = y;
       }
     }
-
-   private:
     void precondition() {
       const int kb = c.kb_;
       if (kb == 0) return;
@@ -1347,6 +1427,11 @@ class wheeled_base {
   std::vector<int> body_prism_{}, body_steer_{};
   std::vector<detail::vec2<Sc>> body_u0_{}, body_ds_{};
   std::vector<Sc> body_c_{}, body_a0_{};
+  /// The base's Schur block on one body, when it is K₀ T(ψ) (prepare_body_base_block): K₀⁻¹
+  /// (kb × kb, column-major; empty: the per-q LU), the positions in D_b of the two prismatic
+  /// columns (or −1).
+  std::vector<Sc> body_kinv_{};
+  std::array<int, 2> body_kpos_{-1, -1};
   bool act_is_eta_ = false;  ///< the actuators are η's joints in η's order: SᵀE = I
   int mobility_ = 0, steerability_ = 0, base_joints_ = 0;
 };
