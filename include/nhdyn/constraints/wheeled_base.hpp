@@ -689,7 +689,7 @@ class wheeled_base {
     base_eqs_.clear(), own_eqs_.clear();
     for (const auto& e : o.base_eqs_) base_eqs_.push_back(e.template cast<Sc>());
     for (const auto& e : o.own_eqs_) own_eqs_.push_back(e.template cast<Sc>());
-    base_joints_ = o.base_joints_;
+    base_joints_ = o.base_joints_, built_ = o.built_;
   }
 
   template <class T>
@@ -941,7 +941,7 @@ class wheeled_base {
   /// steering node, d_β and the constant part of ψ's column, and A at q = 0.
   void prepare_body_kernel() {
     body_yaw_ = -1, body_prism_.clear(), body_u0_.clear(), body_a0_.clear(), body_steer_.clear(), body_ds_.clear(),
-    body_c_.clear(), body_kinv_.clear(), body_kpos_ = {-1, -1};
+    body_c_.clear(), body_kinv_.clear(), body_kpos_ = {-1, -1}, body_rigid_ = false;
     if constexpr (!enclosure_scalar<Sc>) {
       const int nodes = static_cast<int>(plane_.size());
       const auto revolute = [&](int i) { return plane_[std::size_t(i)].revolute && !plane_[std::size_t(i)].spin; };
@@ -992,6 +992,7 @@ class wheeled_base {
       }
       body_a0_ = std::move(a0), body_prism_ = std::move(prism), body_yaw_ = yaw;
       prepare_body_base_block();
+      prepare_body_rigid();
     }
   }
   /// When the base's rows (base_eqs_) come from wheels without a steering joint, each is
@@ -1052,14 +1053,80 @@ class wheeled_base {
       for (int i = 0; i < kb; ++i) a += T(body_kinv_[std::size_t(r + i * kb)]) * x[i];
       y[r] = a;
     }
-    if (const int p = body_kpos_[0], s = body_kpos_[1]; p >= 0) {  // [x_p; x_s] = Paᵀ R(ψ) Pa [y_p; y_s]
-      const auto& a1 = plane_[std::size_t(body_prism_[0])].axis;
-      const auto& a2 = plane_[std::size_t(body_prism_[1])].axis;
-      const vec2<T> v = rotate(cs, vec2<T>(y[p] * T(a1.x()) + y[s] * T(a2.x()), y[p] * T(a1.y()) + y[s] * T(a2.y())));
-      y[p] = T(a1.x()) * v.x() + T(a1.y()) * v.y();
-      y[s] = T(a2.x()) * v.x() + T(a2.y()) * v.y();
-    }
+    if (const int p = body_kpos_[0]; p >= 0) body_pair_turn(cs, y[p], y[body_kpos_[1]]);
     for (int r = 0; r < kb; ++r) x[r] = y[r];
+  }
+  /// [v₁; v₂] ← Paᵀ R(ψ) Pa [v₁; v₂] on the base's two prismatic joints (Pa = [a₁ a₂], their
+  /// orthonormal floor axes), at (cos ψ, sin ψ) = cs; R(−ψ) when cs is conjugated.
+  template <class T>
+  void body_pair_turn(const vec2<T>& cs, T& v1, T& v2) const {
+    const auto& a1 = plane_[std::size_t(body_prism_[0])].axis;
+    const auto& a2 = plane_[std::size_t(body_prism_[1])].axis;
+    const vec2<T> v = rotate(cs, vec2<T>(v1 * T(a1.x()) + v2 * T(a2.x()), v1 * T(a1.y()) + v2 * T(a2.y())));
+    v1 = T(a1.x()) * v.x() + T(a1.y()) * v.y();
+    v2 = T(a2.x()) * v.x() + T(a2.y()) * v.y();
+  }
+  /// When no wheel has a steering joint (fixed and Swedish wheels), every row is ũᵀR(ψ)ᵀa_j on
+  /// a prismatic column and constant on every other: A(q) = A₀ T(ψ), T as in
+  /// prepare_body_base_block but on all of W. With both prismatic joints in D or both in η, and
+  /// neither actuated, the lift and the projection need only constants at ψ = 0 and turns by ψ:
+  ///   S_D = T_D⁻¹ S_D0 T_I,   A_D⁻¹ b = T_D⁻¹ A_D0⁻¹ b,   τ_W = P₀ T_I r_W,
+  /// the last because SᵀE's block is B = T_Iᵀ B₀ (the actuated rows of T⁻¹ are unit rows), so
+  /// B⁻¹ = B₀⁻¹ T_I and W⁻¹Bᵀ(BW⁻¹Bᵀ)⁻¹ = W⁻¹B₀ᵀ(B₀W⁻¹B₀ᵀ)⁻¹ T_I (T_I orthogonal). S_D0, A_D0⁻¹
+  /// and P₀ come from the general kernel at q = 0 (which checks that η determines the motion
+  /// and that the actuators produce it: T is invertible, so both then hold at every q).
+  void prepare_body_rigid() {
+    body_rigid_ = false, body_sd0_.clear(), body_adinv_.clear(), body_act0_.clear();
+    body_dpair_ = {-1, -1}, body_ipair_ = {-1, -1};
+    if (!built_) return;  // a copy the constructor makes before its structure is complete
+    for (const int st : body_steer_)
+      if (st >= 0) return;
+    if (!body_prism_.empty()) {
+      if (body_prism_.size() != 2) return;
+      const vec2<Sc>&a1 = plane_[std::size_t(body_prism_[0])].axis, &a2 = plane_[std::size_t(body_prism_[1])].axis;
+      using std::abs;
+      if (!(abs(a1.dot(a1) - 1) < Sc(1e-12) && abs(a2.dot(a2) - 1) < Sc(1e-12) && abs(a1.dot(a2)) < Sc(1e-12))) return;
+      for (int i = 0; i < 2; ++i) {
+        const int node = body_prism_[std::size_t(i)];
+        body_dpair_[std::size_t(i)] = dcol_[std::size_t(node)], body_ipair_[std::size_t(i)] = icol_[std::size_t(node)];
+      }
+      if ((body_dpair_[0] >= 0) != (body_dpair_[1] >= 0)) return;  // one in D, one in η
+      for (const auto& aw : actw_)
+        if (aw.second == body_prism_[0] || aw.second == body_prism_[1]) return;
+    }
+    const int kk = k(), mwi = mw(), pwi = pw(), mm = m();
+    const vecN<Sc, dynamic> q0 = vecN<Sc, dynamic>::Zero(n_);
+    try {
+      const factored<Sc> f(*this, q0, true);
+      std::vector<Sc> adinv(static_cast<std::size_t>(kk * kk)), e(static_cast<std::size_t>(kk));
+      for (int r = 0; r < kk; ++r) {
+        std::fill(e.begin(), e.end(), Sc(0));
+        e[std::size_t(r)] = Sc(1);
+        f.solve(e.data(), adinv.data() + r * kk);
+      }
+      Eigen::Matrix<Sc, Eigen::Dynamic, Eigen::Dynamic> R = Eigen::Matrix<Sc, Eigen::Dynamic, Eigen::Dynamic>::Zero(mm, mwi),
+                                                       tau(p(), mwi);
+      for (int i = 0; i < mwi; ++i) R(Icol_[std::size_t(i)], i) = Sc(1);
+      actuation_into(q0, f.sd.data(), R, tau);
+      std::vector<Sc> act(static_cast<std::size_t>(pwi * mwi));
+      for (int i = 0; i < mwi; ++i)
+        for (int a = 0; a < pwi; ++a) act[std::size_t(a + i * pwi)] = tau(actw_[std::size_t(a)].first, i);
+      body_sd0_.assign(f.sd.data(), f.sd.data() + kk * mwi), body_adinv_ = std::move(adinv), body_act0_ = std::move(act);
+    } catch (const std::exception&) {
+      return;  // the general kernel reports it at the configuration
+    }
+    body_rigid_ = true;
+  }
+  /// S_D = T_D⁻¹ S_D0 T_I at (cos ψ, sin ψ) = cs (prepare_body_rigid), into sd (k × |η ∩ W|).
+  template <class T>
+  void body_rigid_sd(const vec2<T>& cs, T* sd) const {
+    const int kk = k(), mwi = mw();
+    for (int i = 0; i < kk * mwi; ++i) sd[i] = T(body_sd0_[std::size_t(i)]);
+    if (body_prism_.empty()) return;
+    if (const int i1 = body_ipair_[0]; i1 >= 0)  // a row s times T_I: (T_Iᵀ sᵀ)ᵀ, T_Iᵀ = Paᵀ R(ψ) Pa
+      for (int d = 0; d < kk; ++d) body_pair_turn(cs, sd[d + i1 * kk], sd[d + body_ipair_[1] * kk]);
+    if (const int d1 = body_dpair_[0]; d1 >= 0)
+      for (int i = 0; i < mwi; ++i) body_pair_turn(cs, sd[d1 + i * kk], sd[body_dpair_[1] + i * kk]);
   }
 
   /// A at q on the wheels' paths' columns and the block elimination of A_D (refused, naming the
@@ -1072,6 +1139,7 @@ class wheeled_base {
   struct factored {
     const wheeled_base& c;
     bool body;                                 ///< the rows in closed form (body_rows): X unused, yaw = (cos ψ, sin ψ)
+    bool rigid;                                ///< no wheel steered (prepare_body_rigid): only yaw, ub and sd used
     bool fixed_k;                              ///< K = K₀ T(ψ) (body_base_solve): K and perm unused
     vec2<T> yaw = vec2<T>::Zero();
     detail::wheel_buffer<vec2<T>, dynamic> ub;  ///< body_rows' R(β) u₀ per row (k; empty if not body)
@@ -1087,10 +1155,18 @@ class wheeled_base {
 
     template <class Q>
     factored(const wheeled_base& w, const Q& q, bool with_sd)
-        : c(w), body(w.template body_kernel<T>()), fixed_k(body && !w.body_kinv_.empty()), ub(body ? w.k() : 0),
-          X(body ? 0 : static_cast<int>(w.plane_.size())), aw(w.k() * w.nw()), K(fixed_k ? 0 : w.kb_ * w.kb_),
-          perm(fixed_k ? 0 : w.kb_), H((w.k() - w.kb_) * w.kb_), sd(with_sd ? w.k() * w.mw() : 0) {
+        : c(w), body(w.template body_kernel<T>()), rigid(body && w.body_rigid_),
+          fixed_k(body && !rigid && !w.body_kinv_.empty()), ub(body ? w.k() : 0),
+          X(body ? 0 : static_cast<int>(w.plane_.size())), aw(rigid ? 0 : w.k() * w.nw()),
+          K(rigid || fixed_k ? 0 : w.kb_ * w.kb_), perm(rigid || fixed_k ? 0 : w.kb_), H(rigid ? 0 : (w.k() - w.kb_) * w.kb_),
+          sd(with_sd ? w.k() * w.mw() : 0) {
       const int k = c.k(), kb = c.kb_;
+      if (rigid) {
+        yaw = c.template turn_of<T>(c.body_yaw_, q);
+        for (int r = 0; r < k; ++r) ub[r] = vec2<T>(T(c.body_u0_[std::size_t(r)].x()), T(c.body_u0_[std::size_t(r)].y()));
+        if (with_sd) c.body_rigid_sd(yaw, sd.data());
+        return;
+      }
       if (body)
         c.body_rows(q, aw.data(), yaw, ub.data());
       else
@@ -1142,6 +1218,14 @@ class wheeled_base {
     /// x = A_D⁻¹ b (b: k entries in A's row order; x: k entries in D's order). A planar base's
     /// three dependent velocities (x, y, ψ) at a compile-time size, any other count at run time.
     void solve(const T* b, T* x) const {
+      if (rigid) {  // T_D⁻¹ A_D0⁻¹ b
+        const int k = c.k();
+        for (int d = 0; d < k; ++d) x[d] = T(0);
+        for (int r = 0; r < k; ++r)
+          for (int d = 0; d < k; ++d) x[d] += T(c.body_adinv_[std::size_t(d + r * k)]) * b[r];
+        if (const int d1 = c.body_dpair_[0]; d1 >= 0) c.body_pair_turn(yaw, x[d1], x[c.body_dpair_[1]]);
+        return;
+      }
       if (c.kb_ == 3)
         solve_n<3>(b, x);
       else
@@ -1238,6 +1322,21 @@ class wheeled_base {
     const Eigen::Index cols = r.cols();
     for (const auto& [a, c] : act_eta_)
       for (Eigen::Index j = 0; j < cols; ++j) tau(a, j) = U(r(c, j));
+    if (body_kernel<T>() && body_rigid_) {  // τ_W = P₀ T_I r_W (prepare_body_rigid)
+      const int mwi = mw(), pwi = pw();
+      const vec2<T> cs = turn_of<T>(body_yaw_, q), back(cs.x(), -cs.y());
+      detail::wheel_buffer<U, dynamic> x(mwi);
+      for (Eigen::Index j = 0; j < cols; ++j) {
+        for (int i = 0; i < mwi; ++i) x[i] = U(r(Icol_[std::size_t(i)], j));
+        if (const int i1 = body_ipair_[0]; i1 >= 0) body_pair_turn(vec2<U>(U(back.x()), U(back.y())), x[i1], x[body_ipair_[1]]);
+        for (int a = 0; a < pwi; ++a) {
+          U t(0);
+          for (int i = 0; i < mwi; ++i) t += U(body_act0_[std::size_t(a + i * pwi)]) * x[i];
+          tau(actw_[std::size_t(a)].first, j) = t;
+        }
+      }
+      return;
+    }
     switch (mw()) {
       case 0:  // the wheels allow no motion: their actuators need no torque
         for (const auto& aw : actw_) tau.row(aw.first).setZero();
@@ -1432,7 +1531,13 @@ class wheeled_base {
   /// columns (or −1).
   std::vector<Sc> body_kinv_{};
   std::array<int, 2> body_kpos_{-1, -1};
+  /// No wheel steered (prepare_body_rigid): S_D0 (k × |η ∩ W|), A_D0⁻¹ (k × k, D's order by A's
+  /// rows), P₀ (p_W × |η ∩ W|), all column-major; the prismatic pair's positions in D and in η ∩ W.
+  bool body_rigid_ = false;
+  std::vector<Sc> body_sd0_{}, body_adinv_{}, body_act0_{};
+  std::array<int, 2> body_dpair_{-1, -1}, body_ipair_{-1, -1};
   bool act_is_eta_ = false;  ///< the actuators are η's joints in η's order: SᵀE = I
+  bool built_ = false;       ///< the constructor has finished (its own copies, made before, are not)
   int mobility_ = 0, steerability_ = 0, base_joints_ = 0;
 };
 
@@ -1934,6 +2039,7 @@ void wheeled_base<Sc>::build(const tree<Sc>& t, const wheeled_base_options& o) {
       }
     }
   }
+  built_ = true;
   prepare_body_kernel();
 }
 
