@@ -14,7 +14,7 @@
 /// - `wheels` = `wheeled_base` with the same two fixed wheels (τ, λ, η̇ to 1e-12);
 /// - the closed-form rows of wheels on one body = the general kernel (S, q̈, τ, λ), also with
 ///   scaled radii (A S = 0);
-/// - inverse_dynamics' `evaluate` into a reused τ = the composition's τ bit for bit, for every
+/// - inverse_dynamics' `evaluate` into a reused τ (and its call) = the composition's τ bit for bit, for every
 ///   robot file's constraint (the two paths share the stages, not the storage);
 /// - rank, mobility and the errors: coaxial rows kept once, skid-steer and immobile bases
 ///   reported, a singular configuration and missing actuators named.
@@ -356,14 +356,17 @@ TEST_CASE("inverse_dynamics on a tree: evaluate into a reused tau = the composit
     std::visit(
         [&](const auto& c) {
           const auto id = inverse_dynamics(r.model, c);
+          const auto composition = lift(c) | rne(r.model) | project(c);  // ξ, v and τ as new vectors
           const int p = actuator_count(c);
           VectorXd tau = VectorXd::Constant(p, 7.0);  // reused across the states: every entry rewritten
           for (int trial = 0; trial < 3; ++trial) {
             const VectorXd q = random_q(c.dof(), rng), eta = random_vec(c.m(), rng), eta_dot = random_vec(c.m(), rng, 2);
             id.evaluate(q, eta, eta_dot, tau);
-            const VectorXd call = id(q, eta, eta_dot);  // lift → ξ, rne on ξ, project: three heap vectors
+            const VectorXd call = composition(q, eta, eta_dot);
             REQUIRE(call.size() == p);
             CHECK((tau.array() == call.array()).all());
+            const VectorXd id_call = id(q, eta, eta_dot);  // evaluate into a new τ
+            CHECK((id_call.array() == call.array()).all());
             // into a block of a larger matrix (a map: the caller's own storage)
             MatrixXd out = MatrixXd::Zero(p, 2);
             Eigen::Map<VectorXd> col(out.col(1).data(), p);
@@ -378,7 +381,7 @@ TEST_CASE("inverse_dynamics on a tree: evaluate into a reused tau = the composit
           for (int j = 0; j < c.m(); ++j) ed(j) = D(eta(j), {j == 0 ? 1.0 : 0.0});
           vecN<D, dynamic> td(p);
           id.evaluate(q, ed, ed, td);
-          const vecN<D, dynamic> cd = id(q, ed, ed);
+          const vecN<D, dynamic> cd = composition(q, ed, ed);
           for (int j = 0; j < p; ++j) {
             CHECK(td(j).value() == cd(j).value());
             CHECK(td(j).derivative(0) == cd(j).derivative(0));

@@ -139,7 +139,7 @@ class nh_forward_dynamics_fn : public stage_tag {
   /// rolling_wheels, bicycle, wheeled_base) and the crba method (default), with or without
   /// friction and applied forces. `holonomic`'s and `user_constraint`'s S(q) and the rne_columns
   /// method allocate their own results. The same numbers as the plain call, bit for bit (the
-  /// plain call is this into a new result). `out` must not alias the inputs.
+  /// plain call is this into a result its thread keeps). `out` must not alias the inputs.
   template <class Q, class E, class TAU, class T>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                 nh_forward_dynamics_result<T, N, M>& out) const {
@@ -174,14 +174,29 @@ class nh_forward_dynamics_fn : public stage_tag {
   }
 
  private:
-  /// η̇ for τ and, when Qx is not null, the applied forces' generalized force Q_ext.
+  /// η̇ for τ and, when Qx is not null, the applied forces' generalized force Q_ext: evaluate's
+  /// steps into a result its thread keeps for the next call (one per scalar and size; a nested
+  /// call, from a friction model say, takes a result of its own), so that η̇, copied out, is
+  /// the call's one allocation.
   template <class Q, class E, class TAU, class QX>
   auto solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
              const QX* Qx) const {
     using T0 = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
-    nh_forward_dynamics_result<promote_t<T0, typename QX::Scalar>, N, M> out;
-    solve_into(q, eta, tau, Qx, out);
-    return std::move(out.eta_dot);
+    using result = nh_forward_dynamics_result<promote_t<T0, typename QX::Scalar>, N, M>;
+    thread_local result kept;
+    thread_local bool busy = false;
+    if (busy) {
+      result out;
+      solve_into(q, eta, tau, Qx, out);
+      return std::move(out.eta_dot);
+    }
+    busy = true;
+    struct release {
+      bool& b;
+      ~release() { b = false; }
+    } guard{busy};
+    solve_into(q, eta, tau, Qx, kept);
+    return decltype(kept.eta_dot)(kept.eta_dot);
   }
 
   /// S(q) into out.S (zeros, then the entries the constraint writes, or the constraint's S(q))

@@ -23,6 +23,8 @@
 #include "../dynamics/tree.hpp"
 #include "constraint.hpp"
 #include <Eigen/LU>
+#include <type_traits>
+#include <utility>
 
 namespace nhdyn {
 
@@ -353,6 +355,24 @@ auto nh_tree_pipeline(const tree<S>& t, const C& c, rne_options o, Out out) {
 template <class Composed, class C>
 struct tree_inverse_dynamics : Composed {
   explicit tree_inverse_dynamics(Composed c) : Composed(std::move(c)) {}
+
+  /// The call: with (q, η, η̇) as vectors, evaluate into a new τ (its one allocation: the three
+  /// stages' intermediates stay in evaluate's scratch); any other call form, the composition's.
+  template <class... X>
+  decltype(auto) operator()(X&&... x) const {
+    if constexpr (sizeof...(X) == 3 && (std::is_base_of_v<Eigen::MatrixBase<std::decay_t<X>>, std::decay_t<X>> && ...)) {
+      using R = std::decay_t<decltype(std::declval<const Composed&>()(std::forward<X>(x)...))>;
+      if constexpr (requires(R& r) { this->evaluate(std::forward<X>(x)..., r); }) {
+        R tau(actuator_count(this->f.constraint()));
+        evaluate(std::forward<X>(x)..., tau);
+        return tau;
+      } else {
+        return Composed::operator()(std::forward<X>(x)...);
+      }
+    } else {
+      return Composed::operator()(std::forward<X>(x)...);
+    }
+  }
 
   /// τ into tau (actuator_count(c) entries, of the promoted scalar of the constraint, q, η
   /// and η̇; a vector or a map): bit for bit the call's τ.
