@@ -138,6 +138,47 @@ TEST_CASE("scratch beyond the stack: a block its thread keeps, one per nested bu
   CHECK(got[1] == want);
 }
 
+TEST_CASE("a plain call's kept workspace: the thread's own, one per nested call, each thread its own", "[aba]") {
+  using detail::thread_kept;
+  const std::vector<int>* first = nullptr;
+  {
+    thread_kept<std::vector<int>> a;
+    (*a).assign(5, 1);
+    first = &*a;
+    {
+      thread_kept<std::vector<int>> b;  // nested while a is borrowed: its own, empty
+      CHECK(&*b != first);
+      CHECK((*b).empty());
+      (*b).push_back(9);
+    }
+  }
+  {
+    thread_kept<std::vector<int>> c;  // the thread's object again, as the last call left it
+    CHECK(&*c == first);
+    CHECK(*c == std::vector<int>(5, 1));
+  }
+  const std::vector<int>* other = nullptr;
+  std::thread([&] {
+    thread_kept<std::vector<int>> d;
+    other = &*d;
+    CHECK((*d).empty());
+  }).join();
+  CHECK(other != first);
+  // a call that keeps one (CRBA + LDLT's M, h and factor), over trees of different sizes in
+  // turn: the numbers of evaluate into a fresh workspace each time (test_wheel_kinds does the
+  // constrained forward dynamics' call over every robot file in turn)
+  std::mt19937_64 rng(78);
+  for (const int n : {12, 3, 30, 12}) {
+    const auto t = nhdyn_ref::random_tree(rng, n, 0.4, true);
+    const VectorXd q = random_vec(rng, n, 2), qd = random_vec(rng, n, 2), tau = random_vec(rng, n, 5);
+    const auto fd = forward_dynamics(t, {}, {.method = fd_method::crba_ldlt});
+    forward_dynamics_scratch<double, dynamic> ws;
+    VectorXd want;
+    fd.evaluate(q, qd, tau, ws, want);
+    CHECK(fd(q, qd, tau) == want);
+  }
+}
+
 TEST_CASE("aba far from the world origin: translating the whole tree leaves q̈ unchanged", "[aba]") {
   // A physics invariant (uniform gravity): the robot 1e5…1e6 m from the origin moves as at it.
   // The kernel keeps each body's origin (not the world's), so nothing grows with the distance.

@@ -13,6 +13,7 @@
 
 #include "../dynamics/friction.hpp"
 #include "../dynamics/mass_matrix.hpp"
+#include "../detail/small_buffer.hpp"
 #include "stages.hpp"
 
 namespace nhdyn {
@@ -182,21 +183,9 @@ class nh_forward_dynamics_fn : public stage_tag {
   auto solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
              const QX* Qx) const {
     using T0 = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
-    using result = nh_forward_dynamics_result<promote_t<T0, typename QX::Scalar>, N, M>;
-    thread_local result kept;
-    thread_local bool busy = false;
-    if (busy) {
-      result out;
-      solve_into(q, eta, tau, Qx, out);
-      return std::move(out.eta_dot);
-    }
-    busy = true;
-    struct release {
-      bool& b;
-      ~release() { b = false; }
-    } guard{busy};
-    solve_into(q, eta, tau, Qx, kept);
-    return decltype(kept.eta_dot)(kept.eta_dot);
+    detail::thread_kept<nh_forward_dynamics_result<promote_t<T0, typename QX::Scalar>, N, M>> kept;
+    solve_into(q, eta, tau, Qx, *kept);
+    return decltype((*kept).eta_dot)((*kept).eta_dot);
   }
 
   /// S(q) into out.S (zeros, then the entries the constraint writes, or the constraint's S(q))

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <memory>
 #include <new>
+#include <optional>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -169,6 +170,44 @@ class small_buffer<T, N, Cap> {
 
  private:
   std::array<T, static_cast<std::size_t>(N)> data_;
+};
+
+/// A result or workspace of type T that a call borrows from its thread and leaves, storage and
+/// all, for the thread's next call: a plain call that returns a new vector runs its algorithm's
+/// `evaluate` steps into it, so that the vector it returns is its only allocation once the
+/// thread has met the size. A nested call, while the thread's object is borrowed, gets one of
+/// its own. The object keeps whatever the last call wrote (each `evaluate` rewrites what it
+/// reads).
+template <class T>
+class thread_kept {
+ public:
+  thread_kept() : mine_(!busy()) {
+    if (mine_) {
+      busy() = true;
+      obj_ = &slot();
+    } else {
+      obj_ = &local_.emplace();
+    }
+  }
+  ~thread_kept() {
+    if (mine_) busy() = false;
+  }
+  thread_kept(const thread_kept&) = delete;
+  thread_kept& operator=(const thread_kept&) = delete;
+  T& operator*() { return *obj_; }
+
+ private:
+  static T& slot() {
+    thread_local T kept;
+    return kept;
+  }
+  static bool& busy() {
+    thread_local bool b = false;
+    return b;
+  }
+  bool mine_;
+  std::optional<T> local_{};
+  T* obj_ = nullptr;
 };
 
 }  // namespace nhdyn::detail

@@ -27,6 +27,7 @@
 #include <optional>
 
 #include "../detail/ldlt.hpp"
+#include "../detail/small_buffer.hpp"
 #include "aba.hpp"
 #include "friction.hpp"
 #include "mass_matrix.hpp"
@@ -158,12 +159,13 @@ class forward_dynamics_fn : public stage_tag {
   }
 
  private:
-  /// q̈ = M⁻¹(τ − h) as a new vector (any scalar T: the inputs' promoted one).
+  /// q̈ = M⁻¹(τ − h) as a new vector (any scalar T: the inputs' promoted one), with M, h and the
+  /// factor in a workspace its thread keeps (detail::thread_kept): q̈ is the only allocation.
   template <class T, class Q, class QD, class TAU>
   vecN<T, N> solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau) const {
-    forward_dynamics_scratch<T, N> ws;
+    detail::thread_kept<forward_dynamics_scratch<T, N>> ws;
     vecN<T, N> qdd;
-    solve_into(q, qd, tau, ws, qdd);
+    solve_into(q, qd, tau, *ws, qdd);
     return qdd;
   }
   /// q̈ = M⁻¹(τ − h): CRBA + LDLᵀ or ABA as the options say, into qdd (T: qdd's scalar).
