@@ -360,8 +360,8 @@ batch_function nh_id_of(const Model& mdl, const C& c) {
   const int n = mdl.dof(), k = c.m(), p = nhdyn::actuator_count(c);
   const auto f = nhdyn::inverse_dynamics(mdl, c);
   return {"inverse_dynamics", {{"q", n}, {"eta", k}, {"eta_dot", k}}, {{"tau", p}}, [f, n, k, p](const auto& in, const auto& out) {
-            // the state in per-thread vectors of the library's own type: its run-time-sized
-            // fast path (stack scratch, no heap) takes them; a Map argument took the generic one
+            // the state in per-thread vectors of the library's own type (the call's evaluate
+            // path, stack scratch and τ its one allocation, takes Maps as well since 2026-12-02)
             thread_local VectorXd q, eta, eta_dot;
             q = cmap(in[0], n), eta = cmap(in[1], k), eta_dot = cmap(in[2], k);
             vmap(out[0], p) = f(q, eta, eta_dot);

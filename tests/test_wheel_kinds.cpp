@@ -460,9 +460,12 @@ TEST_CASE("nh_forward_dynamics on a tree: evaluate into one reused result = the 
             const VectorXd q = random_q(n, rng), eta = random_vec(m, rng), eta_dot = random_vec(m, rng, 2);
             const VectorXd tau = id(q, eta, eta_dot);
             fd.evaluate(q, eta, tau, out);
-            const VectorXd call = fd(q, eta, tau);
+            const VectorXd call = fd(q, eta, tau);  // into the result its thread keeps
             REQUIRE(out.eta_dot.size() == m);
             CHECK((out.eta_dot.array() == call.array()).all());
+            nh_forward_dynamics_result<double> fresh;  // no earlier file's sizes or numbers
+            fd.evaluate(q, eta, tau, fresh);
+            CHECK((fresh.eta_dot.array() == call.array()).all());
             // the inverse dynamics' τ gives back its η̇ (the least-norm τ too: SᵀEτ is what it solves)
             CHECK((out.eta_dot - eta_dot).norm() <= 1e-9 * (1 + eta_dot.norm()));
             // the fields against dense products of the constraint's own S(q), E(q) and the CRBA's M(q)

@@ -176,16 +176,23 @@ class nh_forward_dynamics_fn : public stage_tag {
 
  private:
   /// η̇ for τ and, when Qx is not null, the applied forces' generalized force Q_ext: evaluate's
-  /// steps into a result its thread keeps for the next call (one per scalar and size; a nested
-  /// call, from a friction model say, takes a result of its own), so that η̇, copied out, is
-  /// the call's one allocation.
+  /// steps into a result its thread keeps for the next call where sizes are run-time ones (one
+  /// per scalar and size; a nested call, from a friction model say, takes a result of its
+  /// own), so that η̇, copied out, is the call's one allocation; fixed sizes need no heap.
   template <class Q, class E, class TAU, class QX>
   auto solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
              const QX* Qx) const {
     using T0 = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
-    detail::thread_kept<nh_forward_dynamics_result<promote_t<T0, typename QX::Scalar>, N, M>> kept;
-    solve_into(q, eta, tau, Qx, *kept);
-    return decltype((*kept).eta_dot)((*kept).eta_dot);
+    using result = nh_forward_dynamics_result<promote_t<T0, typename QX::Scalar>, N, M>;
+    if constexpr (N == dynamic || M == dynamic) {
+      detail::thread_kept<result> kept;
+      solve_into(q, eta, tau, Qx, *kept);
+      return decltype((*kept).eta_dot)((*kept).eta_dot);
+    } else {
+      result out;
+      solve_into(q, eta, tau, Qx, out);
+      return std::move(out.eta_dot);
+    }
   }
 
   /// S(q) into out.S (zeros, then the entries the constraint writes, or the constraint's S(q))

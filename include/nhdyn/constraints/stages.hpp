@@ -356,13 +356,15 @@ template <class Composed, class C>
 struct tree_inverse_dynamics : Composed {
   explicit tree_inverse_dynamics(Composed c) : Composed(std::move(c)) {}
 
-  /// The call: with (q, η, η̇) as vectors, evaluate into a new τ (its one allocation: the three
-  /// stages' intermediates stay in evaluate's scratch); any other call form, the composition's.
+  /// The call: with (q, η, η̇) as vectors whose promoted scalar is τ's, evaluate into a new τ
+  /// (its one allocation: the three stages' intermediates stay in evaluate's scratch); any other
+  /// call form (a reduced_state, a tree of another scalar than the constraint's), the
+  /// composition's.
   template <class... X>
   decltype(auto) operator()(X&&... x) const {
     if constexpr (sizeof...(X) == 3 && (std::is_base_of_v<Eigen::MatrixBase<std::decay_t<X>>, std::decay_t<X>> && ...)) {
       using R = std::decay_t<decltype(std::declval<const Composed&>()(std::forward<X>(x)...))>;
-      if constexpr (requires(R& r) { this->evaluate(std::forward<X>(x)..., r); }) {
+      if constexpr (requires(R& r) { this->evaluate(std::forward<X>(x)..., r); } && evaluates_into<R, std::decay_t<X>...>()) {
         R tau(actuator_count(this->f.constraint()));
         evaluate(std::forward<X>(x)..., tau);
         return tau;
@@ -372,6 +374,17 @@ struct tree_inverse_dynamics : Composed {
     } else {
       return Composed::operator()(std::forward<X>(x)...);
     }
+  }
+
+  /// Whether evaluate takes an R for τ from (Q, E, ED): its scalar the promoted one.
+  template <class R, class Q, class E, class ED>
+  static constexpr bool evaluates_into() {
+    if constexpr (requires { typename R::Scalar; })
+      return std::is_same_v<typename R::Scalar, promote_t<promote_t<promote_t<typename constraint_scalar<C>::type, typename Q::Scalar>,
+                                                                     typename E::Scalar>,
+                                                          typename ED::Scalar>>;
+    else
+      return false;
   }
 
   /// τ into tau (actuator_count(c) entries, of the promoted scalar of the constraint, q, η

@@ -26,7 +26,9 @@
 /// S. A_D is solved by block elimination: a wheel's own dependent joints (a castor's swivel and
 /// spin, a Swedish wheel's spin, …) appear only in its own rows, with coefficients that do not
 /// change with q, so a constant pivot block per wheel eliminates them, and a small dense system
-/// (K, at each q) remains for the base's dependent joints. The lift computes
+/// (K, at each q; on one body with unsteered base rows K = K₀ T(ψ), factored once, and with no
+/// steered wheel at all A = A₀ T(ψ): docs/theory.md §11) remains for the base's dependent
+/// joints. The lift computes
 /// q̈_D = −A_D⁻¹ (A_I η̇ + Ȧ q̇) with Ȧq̇ from the velocity and bias acceleration of the wheels'
 /// paths (analytic, in the floor plane; `Sdot` is S's derivative by dual numbers, tested
 /// equal). The input map E selects the actuated joints (p of them, τ's order): with p > m, τ
@@ -307,7 +309,9 @@ class wheeled_base {
   static constexpr double row_tolerance = 1e-9;
   /// A_D is refused as singular at a configuration when the base's block left by the
   /// elimination (K) has an LU pivot below this times its largest entry; so is SᵀE's block of
-  /// the wheel-path actuators (and B W⁻¹ Bᵀ, its Gram matrix, at this squared).
+  /// the wheel-path actuators (and B W⁻¹ Bᵀ, its Gram matrix, at this squared). Where K or A
+  /// only turns with ψ (prepare_body_base_block, prepare_body_rigid), the test is made once,
+  /// at construction: its outcome does not change with q.
   static constexpr double singular_tolerance = 1e-10;
 
   wheeled_base() = default;
@@ -1104,13 +1108,15 @@ class wheeled_base {
         e[std::size_t(r)] = Sc(1);
         f.solve(e.data(), adinv.data() + r * kk);
       }
-      Eigen::Matrix<Sc, Eigen::Dynamic, Eigen::Dynamic> R = Eigen::Matrix<Sc, Eigen::Dynamic, Eigen::Dynamic>::Zero(mm, mwi),
-                                                       tau(p(), mwi);
-      for (int i = 0; i < mwi; ++i) R(Icol_[std::size_t(i)], i) = Sc(1);
-      actuation_into(q0, f.sd.data(), R, tau);
       std::vector<Sc> act(static_cast<std::size_t>(pwi * mwi));
-      for (int i = 0; i < mwi; ++i)
-        for (int a = 0; a < pwi; ++a) act[std::size_t(a + i * pwi)] = tau(actw_[std::size_t(a)].first, i);
+      if (mwi > 0) {  // (none: the wheels allow no motion, their actuators need no torque)
+        Eigen::Matrix<Sc, Eigen::Dynamic, Eigen::Dynamic> R = Eigen::Matrix<Sc, Eigen::Dynamic, Eigen::Dynamic>::Zero(mm, mwi),
+                                                         tau(p(), mwi);
+        for (int i = 0; i < mwi; ++i) R(Icol_[std::size_t(i)], i) = Sc(1);
+        actuation_into(q0, f.sd.data(), R, tau);
+        for (int i = 0; i < mwi; ++i)
+          for (int a = 0; a < pwi; ++a) act[std::size_t(a + i * pwi)] = tau(actw_[std::size_t(a)].first, i);
+      }
       body_sd0_.assign(f.sd.data(), f.sd.data() + kk * mwi), body_adinv_ = std::move(adinv), body_act0_ = std::move(act);
     } catch (const std::exception&) {
       return;  // the general kernel reports it at the configuration
@@ -1134,7 +1140,7 @@ class wheeled_base {
   /// dependent joints appear in its own rows only, with coefficients that do not change with q
   /// (the rows and the own joints' columns turn together), so a constant pivot block per wheel
   /// (`wheel_elim`) eliminates them; the rows left form K x_b = b' for the base's dependent
-  /// joints (k_b × k_b, LU with partial pivoting, at each q); and S_D = −A_D⁻¹ A_I. On the stack.
+  /// joints (k_b × k_b, LU with partial pivoting, at each q, unless fixed_k or rigid); and S_D = −A_D⁻¹ A_I. On the stack.
   template <class T>
   struct factored {
     const wheeled_base& c;

@@ -176,15 +176,15 @@ class small_buffer<T, N, Cap> {
 /// all, for the thread's next call: a plain call that returns a new vector runs its algorithm's
 /// `evaluate` steps into it, so that the vector it returns is its only allocation once the
 /// thread has met the size. A nested call, while the thread's object is borrowed, gets one of
-/// its own. The object keeps whatever the last call wrote (each `evaluate` rewrites what it
-/// reads).
+/// its own, as does a call made after the thread's object is destroyed (from another
+/// thread-local object's destructor). The object keeps whatever the last call wrote (each
+/// `evaluate` rewrites what it reads).
 template <class T>
 class thread_kept {
  public:
-  thread_kept() : mine_(!busy()) {
-    if (mine_) {
-      busy() = true;
-      obj_ = &slot();
+  thread_kept() {
+    if (T* s = busy() ? nullptr : slot()) {  // the slot first: if T's construction throws, not busy
+      obj_ = s, mine_ = true, busy() = true;
     } else {
       obj_ = &local_.emplace();
     }
@@ -197,15 +197,24 @@ class thread_kept {
   T& operator*() { return *obj_; }
 
  private:
-  static T& slot() {
-    thread_local T kept;
-    return kept;
+  struct holder {
+    T obj{};
+    bool& gone;
+    explicit holder(bool& g) : gone(g) {}
+    ~holder() { gone = true; }
+  };
+  /// This thread's object, or null once it is destroyed (a trivially destructible flag says so).
+  static T* slot() {
+    thread_local bool gone = false;
+    if (gone) return nullptr;
+    thread_local holder h(gone);
+    return &h.obj;
   }
   static bool& busy() {
     thread_local bool b = false;
     return b;
   }
-  bool mine_;
+  bool mine_ = false;
   std::optional<T> local_{};
   T* obj_ = nullptr;
 };

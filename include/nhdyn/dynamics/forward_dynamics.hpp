@@ -23,6 +23,9 @@
 /// factor and (with friction) τ − τ_f(q̇) in a `forward_dynamics_scratch` reused as well: on a
 /// chain or a tree of any size, no heap allocation once both have their size (ABA's scratch
 /// beyond its stack part, 51 bodies, is a block its thread keeps: detail/small_buffer.hpp).
+/// The call runs the same steps in a workspace its thread keeps (detail::thread_kept): in the
+/// model's scalar and without friction or applied forces (which form τ − τ_f and τ + Q_ext as
+/// new vectors), q̈ is its one allocation.
 #include <cmath>
 #include <optional>
 
@@ -159,13 +162,19 @@ class forward_dynamics_fn : public stage_tag {
   }
 
  private:
-  /// q̈ = M⁻¹(τ − h) as a new vector (any scalar T: the inputs' promoted one), with M, h and the
-  /// factor in a workspace its thread keeps (detail::thread_kept): q̈ is the only allocation.
+  /// q̈ = M⁻¹(τ − h) as a new vector (any scalar T: the inputs' promoted one). On a run-time
+  /// size, M, h and the factor go into a workspace its thread keeps (detail::thread_kept), so
+  /// that in the model's scalar q̈ is the only allocation; a fixed size needs no heap.
   template <class T, class Q, class QD, class TAU>
   vecN<T, N> solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau) const {
-    detail::thread_kept<forward_dynamics_scratch<T, N>> ws;
     vecN<T, N> qdd;
-    solve_into(q, qd, tau, *ws, qdd);
+    if constexpr (N == dynamic) {
+      detail::thread_kept<forward_dynamics_scratch<T, N>> ws;
+      solve_into(q, qd, tau, *ws, qdd);
+    } else {
+      forward_dynamics_scratch<T, N> ws;
+      solve_into(q, qd, tau, ws, qdd);
+    }
     return qdd;
   }
   /// q̈ = M⁻¹(τ − h): CRBA + LDLᵀ or ABA as the options say, into qdd (T: qdd's scalar).
