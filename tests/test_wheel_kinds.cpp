@@ -374,8 +374,16 @@ TEST_CASE("inverse_dynamics on a tree: evaluate into a reused tau = the composit
             CHECK((out.col(1).array() == call.array()).all());
             CHECK(out.col(0).isZero(0));
           }
-          // duals along η: the same numbers and derivatives as the composition's
           using D = dual<double, 1>;
+          {  // a tree of duals with the double constraint: the composition's path (τ's scalar is
+             // not evaluate's), the double τ's values within rounding (the general kernels')
+            const VectorXd q = random_q(c.dof(), rng), eta = random_vec(c.m(), rng), eta_dot = random_vec(c.m(), rng);
+            const VectorXd t0 = id(q, eta, eta_dot);
+            const vecN<D, dynamic> tt = inverse_dynamics(r.model.cast<D>(), c)(q, eta, eta_dot);
+            REQUIRE(tt.size() == p);
+            for (int j = 0; j < p; ++j) CHECK(std::abs(tt(j).value() - t0(j)) <= 1e-12 * (1 + t0.norm()));
+          }
+          // duals along η: the same numbers and derivatives as the composition's
           const VectorXd q = random_q(c.dof(), rng), eta = random_vec(c.m(), rng), eta_dot = random_vec(c.m(), rng);
           vecN<D, dynamic> ed(c.m());
           for (int j = 0; j < c.m(); ++j) ed(j) = D(eta(j), {j == 0 ? 1.0 : 0.0});

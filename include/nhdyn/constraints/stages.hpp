@@ -362,27 +362,31 @@ struct tree_inverse_dynamics : Composed {
   /// composition's.
   template <class... X>
   decltype(auto) operator()(X&&... x) const {
-    if constexpr (sizeof...(X) == 3 && (std::is_base_of_v<Eigen::MatrixBase<std::decay_t<X>>, std::decay_t<X>> && ...)) {
-      using R = std::decay_t<decltype(std::declval<const Composed&>()(std::forward<X>(x)...))>;
-      if constexpr (requires(R& r) { this->evaluate(std::forward<X>(x)..., r); } && evaluates_into<R, std::decay_t<X>...>()) {
-        R tau(actuator_count(this->f.constraint()));
-        evaluate(std::forward<X>(x)..., tau);
-        return tau;
-      } else {
-        return Composed::operator()(std::forward<X>(x)...);
-      }
+    if constexpr (call_evaluates<X...>()) {
+      std::decay_t<decltype(Composed::operator()(std::forward<X>(x)...))> tau(actuator_count(this->f.constraint()));
+      evaluate(std::forward<X>(x)..., tau);
+      return tau;
     } else {
       return Composed::operator()(std::forward<X>(x)...);
     }
   }
-
-  /// Whether evaluate takes an R for τ from (Q, E, ED): its scalar the promoted one.
+  /// τ's scalar for (q, η, η̇) of types Q, E, ED: theirs and the constraint's, promoted.
+  template <class Q, class E, class ED>
+  using tau_scalar = promote_t<promote_t<promote_t<typename constraint_scalar<C>::type, typename Q::Scalar>, typename E::Scalar>,
+                               typename ED::Scalar>;
+  /// Whether the call with X runs evaluate: three Eigen vectors, the composition's τ a vector
+  /// of their and the constraint's promoted scalar (evaluate's own requirement).
+  template <class... X>
+  static constexpr bool call_evaluates() {
+    if constexpr (sizeof...(X) == 3 && (std::is_base_of_v<Eigen::MatrixBase<std::decay_t<X>>, std::decay_t<X>> && ...))
+      return evaluates_into<std::decay_t<decltype(std::declval<const Composed&>()(std::declval<X>()...))>, std::decay_t<X>...>();
+    else
+      return false;
+  }
   template <class R, class Q, class E, class ED>
   static constexpr bool evaluates_into() {
-    if constexpr (requires { typename R::Scalar; })
-      return std::is_same_v<typename R::Scalar, promote_t<promote_t<promote_t<typename constraint_scalar<C>::type, typename Q::Scalar>,
-                                                                     typename E::Scalar>,
-                                                          typename ED::Scalar>>;
+    if constexpr (std::is_base_of_v<Eigen::MatrixBase<R>, R>)
+      return std::is_same_v<typename R::Scalar, tau_scalar<Q, E, ED>>;
     else
       return false;
   }
@@ -396,10 +400,7 @@ struct tree_inverse_dynamics : Composed {
     const auto& dynamics = this->g.f;
     const auto& lifting = this->g.g;
     using T = typename Tau::Scalar;
-    static_assert(std::is_same_v<T, promote_t<promote_t<promote_t<typename constraint_scalar<C>::type, typename Q::Scalar>,
-                                                                 typename E::Scalar>,
-                                                      typename ED::Scalar>>,
-                  "tau's scalar is the promoted scalar of the constraint, q, eta and eta_dot");
+    static_assert(std::is_same_v<T, tau_scalar<Q, E, ED>>, "tau's scalar is the promoted scalar of the constraint, q, eta and eta_dot");
     const int n = dynamics.dof();
     small_buffer<T, dynamic, 512> store(2 * n);  // q̇, then q̈ and v
     Eigen::Map<vecN<T, dynamic>> qd(store.data(), n), v(store.data() + n, n);

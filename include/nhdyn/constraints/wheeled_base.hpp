@@ -213,6 +213,20 @@ struct elim_eq {
   elim_eq<U> cast() const {
     return {row, d, {P[0], P[1]}, {U(coef[0]), U(coef[1])}};
   }
+  /// A base equation's left side on v (A's rows): v[row] − Σ coef_t v[P_t].
+  template <class T>
+  T reduced(const T* v) const {
+    T y = v[row];
+    for (int t = 0; t < d; ++t) y -= T(coef[t]) * v[P[t]];
+    return y;
+  }
+  /// An own joint's equation on v: Σ coef_t v[P_t].
+  template <class T>
+  T combined(const T* v) const {
+    T y = T(coef[0]) * v[P[0]];
+    if (d > 1) y += T(coef[1]) * v[P[1]];
+    return y;
+  }
 };
 
 /// A vector of the floor plane as two plain scalars (the kernel's 2-D arithmetic: Eigen's
@@ -1023,22 +1037,12 @@ class wheeled_base {
           body_kpos_[i] = j, ++found;
         }
     if (found == 1) return;
-    if (found == 2) {
-      const vec2<Sc>&a1 = plane_[std::size_t(body_prism_[0])].axis, &a2 = plane_[std::size_t(body_prism_[1])].axis;
-      using std::abs;
-      if (!(abs(a1.dot(a1) - 1) < Sc(1e-12) && abs(a2.dot(a2) - 1) < Sc(1e-12) && abs(a1.dot(a2)) < Sc(1e-12)))
-        return body_kpos_ = {-1, -1}, void();  // not two orthonormal axes
-    }
+    if (found == 2 && !body_pair_orthonormal()) return body_kpos_ = {-1, -1}, void();
     std::vector<Sc> K(static_cast<std::size_t>(kb * kb)), inv(static_cast<std::size_t>(kb * kb), Sc(0));
     std::vector<int> perm(static_cast<std::size_t>(kb));
-    for (int j = 0; j < kb; ++j)
-      for (int r = 0; r < kb; ++r) {
-        const auto& e = base_eqs_[std::size_t(r)];
-        const Sc* col = body_a0_.data() + Db_[std::size_t(j)] * kk;
-        Sc x = col[e.row];
-        for (int t = 0; t < e.d; ++t) x -= e.coef[t] * col[e.P[t]];
-        K[std::size_t(r + j * kb)] = x;
-      }
+    for (int j = 0; j < kb; ++j)  // K at q = 0, as factored forms it at q
+      for (int r = 0; r < kb; ++r)
+        K[std::size_t(r + j * kb)] = base_eqs_[std::size_t(r)].reduced(body_a0_.data() + Db_[std::size_t(j)] * kk);
     if (detail::lu_in_place(K.data(), kb, perm.data()) < 100 * singular_tolerance) return body_kpos_ = {-1, -1}, void();
     for (int j = 0; j < kb; ++j) {
       inv[std::size_t(j + j * kb)] = Sc(1);
@@ -1059,6 +1063,12 @@ class wheeled_base {
     }
     if (const int p = body_kpos_[0]; p >= 0) body_pair_turn(cs, y[p], y[body_kpos_[1]]);
     for (int r = 0; r < kb; ++r) x[r] = y[r];
+  }
+  /// Whether the base's two prismatic joints slide along orthonormal floor axes (T orthogonal).
+  bool body_pair_orthonormal() const {
+    const vec2<Sc>&a1 = plane_[std::size_t(body_prism_[0])].axis, &a2 = plane_[std::size_t(body_prism_[1])].axis;
+    using std::abs;
+    return abs(a1.dot(a1) - 1) < Sc(1e-12) && abs(a2.dot(a2) - 1) < Sc(1e-12) && abs(a1.dot(a2)) < Sc(1e-12);
   }
   /// [v₁; v₂] ← Paᵀ R(ψ) Pa [v₁; v₂] on the base's two prismatic joints (Pa = [a₁ a₂], their
   /// orthonormal floor axes), at (cos ψ, sin ψ) = cs; R(−ψ) when cs is conjugated.
@@ -1086,10 +1096,7 @@ class wheeled_base {
     for (const int st : body_steer_)
       if (st >= 0) return;
     if (!body_prism_.empty()) {
-      if (body_prism_.size() != 2) return;
-      const vec2<Sc>&a1 = plane_[std::size_t(body_prism_[0])].axis, &a2 = plane_[std::size_t(body_prism_[1])].axis;
-      using std::abs;
-      if (!(abs(a1.dot(a1) - 1) < Sc(1e-12) && abs(a2.dot(a2) - 1) < Sc(1e-12) && abs(a1.dot(a2)) < Sc(1e-12))) return;
+      if (body_prism_.size() != 2 || !body_pair_orthonormal()) return;
       for (int i = 0; i < 2; ++i) {
         const int node = body_prism_[std::size_t(i)];
         body_dpair_[std::size_t(i)] = dcol_[std::size_t(node)], body_ipair_[std::size_t(i)] = icol_[std::size_t(node)];
@@ -1128,7 +1135,6 @@ class wheeled_base {
   void body_rigid_sd(const vec2<T>& cs, T* sd) const {
     const int kk = k(), mwi = mw();
     for (int i = 0; i < kk * mwi; ++i) sd[i] = T(body_sd0_[std::size_t(i)]);
-    if (body_prism_.empty()) return;
     if (const int i1 = body_ipair_[0]; i1 >= 0)  // a row s times T_I: (T_Iᵀ sᵀ)ᵀ, T_Iᵀ = Paᵀ R(ψ) Pa
       for (int d = 0; d < kk; ++d) body_pair_turn(cs, sd[d + i1 * kk], sd[d + body_ipair_[1] * kk]);
     if (const int d1 = body_dpair_[0]; d1 >= 0)
@@ -1182,18 +1188,9 @@ class wheeled_base {
       // H = Pinv A[P, D_b] of each own dependent joint
       for (int j = 0; j < kb; ++j) {
         const T* col = aw.data() + c.Db_[std::size_t(j)] * k;
-        for (int r = 0; r < kb && !fixed_k; ++r) {
-          const auto& e = c.base_eqs_[std::size_t(r)];
-          T x = col[e.row];
-          for (int t = 0; t < e.d; ++t) x -= T(e.coef[t]) * col[e.P[t]];
-          K[r + j * kb] = x;
-        }
-        for (int o = 0; o < k - kb; ++o) {
-          const auto& e = c.own_eqs_[std::size_t(o)];
-          T x = T(e.coef[0]) * col[e.P[0]];
-          if (e.d > 1) x += T(e.coef[1]) * col[e.P[1]];
-          H[o + j * (k - kb)] = x;
-        }
+        if (!fixed_k)
+          for (int r = 0; r < kb; ++r) K[r + j * kb] = c.base_eqs_[std::size_t(r)].reduced(col);
+        for (int o = 0; o < k - kb; ++o) H[o + j * (k - kb)] = c.own_eqs_[std::size_t(o)].combined(col);
       }
       if constexpr (enclosure_scalar<T>) precondition();
       if (kb > 0 && !fixed_k && detail::lu_in_place(K.data(), kb, perm.data()) < singular_tolerance)
@@ -1202,12 +1199,7 @@ class wheeled_base {
         if (kb == 0) {  // every dependent joint a wheel's own: S_D(o, i) = −Σ Pinv A(P, I_i)
           for (int i = 0; i < c.mw(); ++i) {
             const T* col = aw.data() + c.I_[std::size_t(i)] * k;
-            for (int o = 0; o < k; ++o) {
-              const auto& e = c.own_eqs_[std::size_t(o)];
-              T y = T(e.coef[0]) * col[e.P[0]];
-              if (e.d > 1) y += T(e.coef[1]) * col[e.P[1]];
-              sd[e.row + i * k] = -y;
-            }
+            for (const auto& e : c.own_eqs_) sd[e.row + i * k] = -e.combined(col);
           }
         } else {
           detail::wheel_buffer<T, dynamic> b(k);
@@ -1243,12 +1235,7 @@ class wheeled_base {
     void solve_n(const T* b, T* x) const {
       const int k = c.k(), kb = KB == dynamic ? c.kb_ : KB;
       detail::wheel_buffer<T, KB> bb(kb);
-      for (int r = 0; r < kb; ++r) {
-        const auto& e = c.base_eqs_[std::size_t(r)];
-        T y = b[e.row];
-        for (int t = 0; t < e.d; ++t) y -= T(e.coef[t]) * b[e.P[t]];
-        bb[r] = y;
-      }
+      for (int r = 0; r < kb; ++r) bb[r] = c.base_eqs_[std::size_t(r)].reduced(b);
       if (fixed_k)
         c.template body_base_solve<KB>(yaw, bb.data());
       else if (kb > 0) {
@@ -1266,8 +1253,7 @@ class wheeled_base {
       for (int j = 0; j < kb; ++j) x[c.Db_pos_[std::size_t(j)]] = bb[j];
       for (int o = 0; o < k - kb; ++o) {
         const auto& e = c.own_eqs_[std::size_t(o)];
-        T y = T(e.coef[0]) * b[e.P[0]];
-        if (e.d > 1) y += T(e.coef[1]) * b[e.P[1]];
+        T y = e.combined(b);
         for (int j = 0; j < kb; ++j) y -= H[o + j * (k - kb)] * bb[j];
         x[e.row] = y;
       }
@@ -1328,21 +1314,8 @@ class wheeled_base {
     const Eigen::Index cols = r.cols();
     for (const auto& [a, c] : act_eta_)
       for (Eigen::Index j = 0; j < cols; ++j) tau(a, j) = U(r(c, j));
-    if (body_kernel<T>() && body_rigid_) {  // τ_W = P₀ T_I r_W (prepare_body_rigid)
-      const int mwi = mw(), pwi = pw();
-      const vec2<T> cs = turn_of<T>(body_yaw_, q), back(cs.x(), -cs.y());
-      detail::wheel_buffer<U, dynamic> x(mwi);
-      for (Eigen::Index j = 0; j < cols; ++j) {
-        for (int i = 0; i < mwi; ++i) x[i] = U(r(Icol_[std::size_t(i)], j));
-        if (const int i1 = body_ipair_[0]; i1 >= 0) body_pair_turn(vec2<U>(U(back.x()), U(back.y())), x[i1], x[body_ipair_[1]]);
-        for (int a = 0; a < pwi; ++a) {
-          U t(0);
-          for (int i = 0; i < mwi; ++i) t += U(body_act0_[std::size_t(a + i * pwi)]) * x[i];
-          tau(actw_[std::size_t(a)].first, j) = t;
-        }
-      }
-      return;
-    }
+    if constexpr (std::is_same_v<typename Q::Scalar, T>)  // (a q of another scalar: the general path)
+      if (body_kernel<T>() && body_rigid_) return body_rigid_actuation_into<U>(turn_of<T>(body_yaw_, q), r, tau);
     switch (mw()) {
       case 0:  // the wheels allow no motion: their actuators need no torque
         for (const auto& aw : actw_) tau.row(aw.first).setZero();
@@ -1351,6 +1324,23 @@ class wheeled_base {
         return wheel_actuation_into<3>(q, sd, r, tau);
       default:
         return wheel_actuation_into<dynamic>(q, sd, r, tau);
+    }
+  }
+  /// actuation_into's wheel-path block with no steered wheel: τ_W = P₀ T_I r_W
+  /// (prepare_body_rigid), at (cos ψ, sin ψ) = cs.
+  template <class U, class T, class R, class Out>
+  void body_rigid_actuation_into(const vec2<T>& cs, const R& r, Out& tau) const {
+    const int mwi = mw(), pwi = pw();
+    const vec2<U> back(U(cs.x()), U(-cs.y()));  // R(−ψ)
+    detail::wheel_buffer<U, dynamic> x(mwi);
+    for (Eigen::Index j = 0; j < r.cols(); ++j) {
+      for (int i = 0; i < mwi; ++i) x[i] = U(r(Icol_[std::size_t(i)], j));
+      if (const int i1 = body_ipair_[0]; i1 >= 0) body_pair_turn(back, x[i1], x[body_ipair_[1]]);
+      for (int a = 0; a < pwi; ++a) {
+        U t(0);
+        for (int i = 0; i < mwi; ++i) t += U(body_act0_[std::size_t(a + i * pwi)]) * x[i];
+        tau(actw_[std::size_t(a)].first, j) = t;
+      }
     }
   }
   /// actuation_into's wheel-path block, |η ∩ W| = MW (or dynamic).
