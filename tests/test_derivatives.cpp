@@ -303,3 +303,47 @@ TEST_CASE("derivatives: a constraint for another model, and bad inputs, are refu
   q(2) = std::numeric_limits<double>::infinity();
   CHECK_THROWS_AS(d(q, z4, z4), input_error);
 }
+
+TEST_CASE("derivatives' plain calls: the outputs of evaluate into a fresh result, no scratch, also after a call that failed midway") {
+  // The calls in double evaluate into a result their thread keeps and move its outputs out;
+  // the kept scratch then serves other objects, sizes and constraints, and a call that threw
+  // after writing part of it (q̈ overflows once M, h and the factor are formed).
+  std::mt19937_64 rng(2026);
+  for (const char* file : {"mecanum_arm.json", "castor_drive_arm.json", "mobile_manipulator.json"}) {
+    const auto r = io::load_robot_file(source("examples/robots/") + file);
+    REQUIRE(r.constraint);
+    std::visit([&](const auto& c) {
+      const auto& t = r.model;
+      const int n = c.dof(), m = c.m(), p = actuator_count(c);
+      INFO(file);
+      const VectorXd q = random_vec(rng, n, 1.5), eta = random_vec(rng, m, 1), ed = random_vec(rng, m, 1),
+                     tau = random_vec(rng, p, 5), qd = random_vec(rng, n, 1), tq = random_vec(rng, n, 5);
+      const auto id = inverse_dynamics_derivatives(t, c);
+      const auto nfd = forward_dynamics_derivatives(t, c);
+      const auto hfd = forward_dynamics_derivatives(t);
+      CHECK_THROWS(hfd(q, qd, VectorXd::Constant(n, 1e308)));
+      CHECK_THROWS(nfd(q, eta, VectorXd::Constant(p, 1e308)));
+      const auto a = id(q, eta, ed);
+      const auto b = nfd(q, eta, tau);
+      const auto h = hfd(q, qd, tq);
+      nh_derivatives_result<double, std::decay_t<decltype(c)>::m_at_compile_time> ea;
+      nh_fd_derivatives_result<double, std::decay_t<decltype(c)>::m_at_compile_time> eb;
+      fd_derivatives_result<double> eh;
+      id.evaluate(q, eta, ed, ea);
+      nfd.evaluate(q, eta, tau, eb);
+      hfd.evaluate(q, qd, tq, eh);
+      CHECK((a.J() == ea.J() && a.tau == ea.tau && a.dqd_dq == ea.dqd_dq && a.id.M == ea.id.M && a.id.dq == ea.id.dq));
+      CHECK((b.ss.A == eb.ss.A && b.ss.B == eb.ss.B && b.eta_dot == eb.eta_dot && b.id.J() == eb.id.J()));
+      CHECK((h.qdd == eh.qdd && h.dq == eh.dq && h.dqd == eh.dqd && h.Minv == eh.Minv && h.id.M == eh.id.M));
+      // a returned result carries its outputs only
+      CHECK((a.work.se.size() == 0 && a.work.z.size() == 0 && a.work.q.size() == 0));
+      CHECK((b.id.work.z.size() == 0 && b.fd.eta_dot.size() == 0 && b.redundant.y.size() == 0));
+      CHECK((h.rhs.size() == 0 && h.fd.M.size() == 0 && h.fd.h.size() == 0));
+      // and the outputs are the independent references' (the dual linearizers)
+      CHECK(rel(a.J(), inverse_dynamics_linearizer(t, c)(q, eta, ed).J) < 1e-12);
+      // (M⁻¹ of a free tree whose wheels and castors are light: A keeps fewer digits, 1.0e-10
+      // apart on castor_drive_arm)
+      CHECK(rel(h.state_space_model().A, linearize_forward_dynamics(t, q, qd, tq).A) < 1e-9);
+    }, *r.constraint);
+  }
+}

@@ -319,6 +319,10 @@ TEST_CASE("external wrenches: the textbook RNEA with body forces, KDL-free Jacob
         Qj += J.topRows(3).transpose() * f + J.bottomRows(3).transpose() * m;
       }
       CHECK(rel(fx.generalized_force(q), Qj) <= 1e-14);
+      // …and the calls with wrenches are those without at τ + Q_ext (v − Q_ext), Q_ext by hand
+      CHECK(rel(forward_dynamics(t)(q, qd, tau, fx), forward_dynamics(t)(q, qd, VectorXd(tau + Qj))) <= 1e-12);
+      CHECK(rel(aba(t)(q, qd, tau, fx), aba(t)(q, qd, VectorXd(tau + Qj))) <= 1e-12);
+      CHECK(rel(tau, VectorXd(rne(t)(q, qd, qdd) - Qj)) <= 1e-12);
       // (6) the evaluate forms with wrenches: the calls' numbers bit for bit, into reused storage
       VectorXd v = VectorXd::Constant(n, 7.0), a = VectorXd::Constant(n, 7.0), b;
       rne(t).evaluate(q, qd, qdd, fx, v);

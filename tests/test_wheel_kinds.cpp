@@ -871,3 +871,33 @@ TEST_CASE("wheeled_base: a wheel that does not touch the floor warns and goes on
   CHECK(said[0].find("w0_spin") != std::string::npos);
   CHECK(said[0].find("does not touch the floor") != std::string::npos);
 }
+
+TEST_CASE("inverse_dynamics with friction on a tree: evaluate and the call = lift | (rne + friction) | project, "
+          "the friction's share its projection", "[wheel_kinds]") {
+  std::mt19937 rng(2027);
+  for (const char* file : {"mecanum_arm.json", "mobile_manipulator.json", "powered_castors_arm.json"}) {
+    const auto r = load(file);
+    std::visit([&](const auto& c) {
+      const auto& t = r.model;
+      const int n = t.dof(), p = actuator_count(c);
+      std::vector<joint_friction> laws;
+      for (int j = 0; j < n; ++j) laws.push_back({0.3 + 0.05 * j, 0.2, -0.15});
+      const friction_fn fr(laws, coulomb_law::smooth(0.05));
+      const auto id = inverse_dynamics(t, c, {}, fr);
+      const auto by_hand = lift(c) | (rne(t) + fr) | project(c);  // ξ, v, τ_f and τ as new vectors
+      VectorXd tau = VectorXd::Constant(p, 7.0);
+      for (int k = 0; k < 3; ++k) {
+        INFO(file << ", state " << k);
+        const VectorXd q = random_q(n, rng), eta = random_vec(c.m(), rng), eta_dot = random_vec(c.m(), rng);
+        id.evaluate(q, eta, eta_dot, tau);
+        const VectorXd want = by_hand(q, eta, eta_dot);
+        CHECK((tau.array() == want.array()).all());
+        CHECK((id(q, eta, eta_dot).array() == want.array()).all());
+        // the friction's share is its projection, P linear: τ − τ(no friction) = P τ_f(Sη)
+        const VectorXd share = project(c)(q, fr(VectorXd(c.S(q) * eta)));
+        CHECK((tau - VectorXd(inverse_dynamics(t, c)(q, eta, eta_dot)) - share).cwiseAbs().maxCoeff() <=
+              1e-9 * (1 + tau.cwiseAbs().maxCoeff()));
+      }
+    }, *r.constraint);
+  }
+}

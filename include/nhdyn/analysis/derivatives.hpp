@@ -225,6 +225,15 @@ auto& run_time_or_local(Kept& kept, Local& local) {
   else
     return local;
 }
+/// A plain call in the model's scalar: `evaluate` into a result of type R its thread keeps
+/// (detail::thread_kept), then its outputs moved into a new R by take(kept) — the scratch
+/// stays behind for the thread's next call, so the call allocates its output only.
+template <class R, class Evaluate, class Take>
+R kept_call(const Evaluate& evaluate, const Take& take) {
+  thread_kept<R> kept;
+  evaluate(*kept);
+  return take(*kept);
+}
 }  // namespace detail
 
 /// τ and ∂τ/∂(q, η, η̇) of the nonholonomic inverse dynamics, and ∂q̇/∂q of the lift
@@ -243,6 +252,13 @@ struct nh_derivatives_result {
     Eigen::Matrix<T, M, Eigen::Dynamic> j(tau.size(), dq.cols() + deta.cols() + deta_dot.cols());
     j << dq, deta, deta_dot;
     return j;
+  }
+  /// The outputs moved into a new result (no copy), this one keeping its scratch (`work`).
+  nh_derivatives_result take_outputs() {
+    nh_derivatives_result r;
+    r.tau = std::move(tau), r.dq = std::move(dq), r.deta = std::move(deta), r.deta_dot = std::move(deta_dot);
+    r.dqd_dq = std::move(dqd_dq), r.id = std::move(id);
+    return r;
   }
   /// Scratch of the computation, kept by evaluate for its next call (empty in a result that
   /// operator() returns): S(q + ε q̇) where the constraint writes into a matrix (S_into), S's
@@ -287,22 +303,34 @@ class inverse_dynamics_derivatives_fn {
   /// The joints whose columns of ∂q̇/∂q, ∂q̈/∂q and ∂P/∂q are seeded as dual directions.
   const std::vector<int>& constraint_columns() const { return cols_; }
 
+  /// The call: in the model's scalar, evaluate into a result its thread keeps and the outputs
+  /// moved out (they are its only allocations); in another scalar, a result of its own.
   template <class Q, class E, class ED>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                   const Eigen::MatrixBase<ED>& eta_dot) const {
-    nh_derivatives_result<result_scalar<Q, E, ED>, C::m_at_compile_time> out;
-    run(q, eta, eta_dot, out, [&](const auto& x, const auto& xd, const auto& xdd, auto& r) { r = d_(x, xd, xdd); });
-    out.work = {};
-    return out;
+    using R = nh_derivatives_result<result_scalar<Q, E, ED>, C::m_at_compile_time>;
+    if constexpr (detail::in_scalar<S, Q, E, ED>) {
+      return detail::kept_call<R>([&](R& k) { evaluate(q, eta, eta_dot, k); }, [](R& k) { return k.take_outputs(); });
+    } else {
+      R out;
+      run(q, eta, eta_dot, out, [&](const auto& x, const auto& xd, const auto& xdd, auto& r) { r = d_(x, xd, xdd); });
+      out.work = {};
+      return out;
+    }
   }
   template <class Q, class E, class ED, class Kin, class W>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
                   const external_wrenches_fn<Kin, W>& w) const {
-    nh_derivatives_result<promote_t<result_scalar<Q, E, ED>, W>, C::m_at_compile_time> out;
-    run(q, eta, eta_dot, out,
-        [&](const auto& x, const auto& xd, const auto& xdd, auto& r) { r = d_(x, xd, xdd, w); });
-    out.work = {};
-    return out;
+    using R = nh_derivatives_result<promote_t<result_scalar<Q, E, ED>, W>, C::m_at_compile_time>;
+    if constexpr (detail::in_scalar<S, Q, E, ED> && std::is_same_v<W, S>) {
+      return detail::kept_call<R>([&](R& k) { evaluate(q, eta, eta_dot, w, k); }, [](R& k) { return k.take_outputs(); });
+    } else {
+      R out;
+      run(q, eta, eta_dot, out,
+          [&](const auto& x, const auto& xd, const auto& xdd, auto& r) { r = d_(x, xd, xdd, w); });
+      out.work = {};
+      return out;
+    }
   }
   /// Into a result whose storage (matrices and scratch) is reused from call to call, for
   /// inputs in the model's scalar: no heap allocation once `out` has its sizes, where the
@@ -524,6 +552,13 @@ struct fd_derivatives_result {
     s.B.bottomRows(n) = Minv;
     return s;
   }
+  /// The outputs moved into a new result (no copy), this one keeping its scratch.
+  fd_derivatives_result take_outputs() {
+    fd_derivatives_result r;
+    r.qdd = std::move(qdd), r.dq = std::move(dq), r.dqd = std::move(dqd), r.Minv = std::move(Minv);
+    r.id = std::move(id);
+    return r;
+  }
   /// Scratch of the computation, kept by evaluate for its next call (empty in a result that
   /// operator() returns): M's factorisation and the right-hand sides [∂τ/∂q  ∂τ/∂q̇  I], and
   /// the forward dynamics' own (M, h, their factor where CRBA + LDLᵀ answers).
@@ -539,7 +574,8 @@ struct fd_derivatives_result {
 /// `evaluate(q, qd, tau [, w], out)` reuses out's matrices and scratch from call to call
 /// (inputs and wrenches in the model's scalar): no heap allocation once out has the tree's size,
 /// on trees of any size (the kernels' scratch beyond its stack part is a block the thread keeps,
-/// detail/small_buffer.hpp; with wrenches, Q_ext and τ + Q_ext are new vectors).
+/// detail/small_buffer.hpp). The call in the model's scalar runs evaluate into a result its
+/// thread keeps and moves the outputs out (detail::kept_call): they are its only allocations.
 template <class S>
 class fd_derivatives_fn {
  public:
@@ -551,17 +587,29 @@ class fd_derivatives_fn {
   }
   int dof() const { return d_.dof(); }
 
+  /// The call: in the model's scalar, evaluate into a result its thread keeps and the outputs
+  /// moved out (they are its only allocations); in another scalar, a result of its own.
   template <class Q, class QD, class TAU>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
                   const Eigen::MatrixBase<TAU>& tau) const {
-    const auto qdd = fd_(q, qd, tau);
-    return finish(qdd, d_(q, qd, qdd));
+    if constexpr (detail::in_scalar<S, Q, QD, TAU>) {
+      using R = fd_derivatives_result<S>;
+      return detail::kept_call<R>([&](R& k) { evaluate(q, qd, tau, k); }, [](R& k) { return k.take_outputs(); });
+    } else {
+      const auto qdd = fd_(q, qd, tau);
+      return finish(qdd, d_(q, qd, qdd));
+    }
   }
   template <class Q, class QD, class TAU, class Kin, class W>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                   const external_wrenches_fn<Kin, W>& w) const {
-    const auto qdd = fd_(q, qd, tau, w);
-    return finish(qdd, d_(q, qd, qdd, w));
+    if constexpr (detail::in_scalar<S, Q, QD, TAU> && std::is_same_v<W, S>) {
+      using R = fd_derivatives_result<S>;
+      return detail::kept_call<R>([&](R& k) { evaluate(q, qd, tau, w, k); }, [](R& k) { return k.take_outputs(); });
+    } else {
+      const auto qdd = fd_(q, qd, tau, w);
+      return finish(qdd, d_(q, qd, qdd, w));
+    }
   }
   /// Into a result whose storage is reused (see the class comment). `out` must not alias the
   /// inputs; after an exception its contents are unspecified.
@@ -642,6 +690,12 @@ struct nh_fd_derivatives_result {
   nh_forward_dynamics_result<T, Eigen::Dynamic, M> fd;
   Eigen::PartialPivLU<Eigen::Matrix<T, M, M>> lu;
   detail::redundant_eta_scratch<T> redundant;  ///< with more actuators than η (p > m)
+  /// The outputs moved into a new result (no copy), this one keeping its scratch.
+  nh_fd_derivatives_result take_outputs() {
+    nh_fd_derivatives_result r;
+    r.eta_dot = std::move(eta_dot), r.ss = std::move(ss), r.id = id.take_outputs();
+    return r;
+  }
 };
 
 /// A, B of a constrained tree's forward dynamics, analytically:
@@ -654,31 +708,27 @@ class nh_fd_derivatives_fn {
   nh_fd_derivatives_fn(const tree<S>& t, const C& c, rne_options o = {})
       : fd_(nh_forward_dynamics(t, c, o)), id_(t, c, o) {}
 
+  /// The call: in the model's scalar, evaluate into a result its thread keeps and the outputs
+  /// moved out (they are its only allocations); in another scalar, a result of its own.
   template <class Q, class E, class TAU>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta,
                   const Eigen::MatrixBase<TAU>& tau) const {
-    const auto ed = fd_(q, eta, tau);
-    auto J = id_(q, eta, ed);
-    nh_fd_derivatives_result<typename decltype(J)::scalar_type, C::m_at_compile_time> out;
-    out.id = std::move(J);
-    finish(q, tau, ed, id_.constraint().S(q), out);
-    out.id.work = {};
-    out.lu = {};
-    out.redundant = {};
-    return out;
+    if constexpr (detail::in_scalar<S, Q, E, TAU>) {
+      using R = nh_fd_derivatives_result<S, C::m_at_compile_time>;
+      return detail::kept_call<R>([&](R& k) { evaluate(q, eta, tau, k); }, [](R& k) { return k.take_outputs(); });
+    } else {
+      return own_result(q, tau, fd_(q, eta, tau), [&](const auto& ed) { return id_(q, eta, ed); });
+    }
   }
   template <class Q, class E, class TAU, class Kin, class W>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                   const external_wrenches_fn<Kin, W>& w) const {
-    const auto ed = fd_(q, eta, tau, w);
-    auto J = id_(q, eta, ed, w);
-    nh_fd_derivatives_result<typename decltype(J)::scalar_type, C::m_at_compile_time> out;
-    out.id = std::move(J);
-    finish(q, tau, ed, id_.constraint().S(q), out);
-    out.id.work = {};
-    out.lu = {};
-    out.redundant = {};
-    return out;
+    if constexpr (detail::in_scalar<S, Q, E, TAU> && std::is_same_v<W, S>) {
+      using R = nh_fd_derivatives_result<S, C::m_at_compile_time>;
+      return detail::kept_call<R>([&](R& k) { evaluate(q, eta, tau, w, k); }, [](R& k) { return k.take_outputs(); });
+    } else {
+      return own_result(q, tau, fd_(q, eta, tau, w), [&](const auto& ed) { return id_(q, eta, ed, w); });
+    }
   }
   /// Into a result whose storage is reused: no allocation once it has its sizes, where the
   /// constraint is run-time sized, also with more actuators than η (p > m) where it writes E τ
@@ -699,6 +749,19 @@ class nh_fd_derivatives_fn {
   }
 
  private:
+  /// The call in another scalar than the model's: η̇, then id's derivatives there (by `id`)
+  /// and A, B into a result of its own, without scratch.
+  template <class Q, class TAU, class ED, class Id>
+  auto own_result(const Q& q, const TAU& tau, const ED& ed, const Id& id) const {
+    auto J = id(ed);
+    nh_fd_derivatives_result<typename decltype(J)::scalar_type, C::m_at_compile_time> out;
+    out.id = std::move(J);
+    finish(q, tau, ed, id_.constraint().S(q), out);
+    out.id.work = {};
+    out.lu = {};
+    out.redundant = {};
+    return out;
+  }
   /// evaluate, with or without the wrenches (`w...`: none or one).
   template <class Q, class E, class TAU, class... W>
   void evaluate_into(const Q& q, const E& eta, const TAU& tau, nh_fd_derivatives_result<S, C::m_at_compile_time>& out,

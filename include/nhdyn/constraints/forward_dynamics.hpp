@@ -129,9 +129,16 @@ class nh_forward_dynamics_fn : public stage_tag {
   template <class Q, class E, class TAU, applied_forces F>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                   const F& fx) const {
-    detail::check_size(q, c_.dof(), "q");
-    const auto Qx = fx.generalized_force(q);
-    return solve(q, eta, tau, &Qx);
+    if constexpr (N == dynamic || M == dynamic) {  // evaluate into a result its thread keeps, Q_ext too
+      using T0 = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
+      detail::thread_kept<nh_forward_dynamics_result<promote_t<T0, detail::applied_scalar_t<F, Q>>, N, M>> kept;
+      evaluate(q, eta, tau, fx, *kept);
+      return decltype((*kept).eta_dot)((*kept).eta_dot);
+    } else {
+      detail::check_size(q, c_.dof(), "q");
+      const auto Qx = fx.generalized_force(q);
+      return solve(q, eta, tau, &Qx);
+    }
   }
 
   /// η̇ into `out.eta_dot`, with M(q), S(q), M_η, its factor, h_η and SᵀEτ beside it (the

@@ -414,16 +414,23 @@ struct tree_inverse_dynamics : Composed {
 /// The nonholonomic inverse dynamics of a tree: project ∘ rne ∘ lift, the constraint over the
 /// tree's joints in q order. With a run-time-sized constraint that lifts into given storage,
 /// it also evaluates into a τ the caller reuses (`evaluate(q, eta, eta_dot, tau)`).
-template <class S, pfaffian_constraint C>
-auto inverse_dynamics(const tree<S>& t, const C& c, rne_options o = {}) {
-  auto id = detail::nh_tree_pipeline(t, c, o, project(c));
+namespace detail {
+/// The composition id, as tree_inverse_dynamics (with evaluate) where the constraint is run-time
+/// sized and lifts into given storage.
+template <class S, class C, class Id>
+auto with_tree_evaluate(Id id) {
   constexpr bool lifts_into = requires(const C& k, const vecN<S, dynamic>& x, Eigen::Map<vecN<S, dynamic>>& m) {
     k.lift_into(x, x, x, m, m);
   };
   if constexpr (C::n_at_compile_time == dynamic && lifts_into)
-    return detail::tree_inverse_dynamics<decltype(id), C>(std::move(id));
+    return tree_inverse_dynamics<Id, C>(std::move(id));
   else
     return id;
+}
+}  // namespace detail
+template <class S, pfaffian_constraint C>
+auto inverse_dynamics(const tree<S>& t, const C& c, rne_options o = {}) {
+  return detail::with_tree_evaluate<S, C>(detail::nh_tree_pipeline(t, c, o, project(c)));
 }
 /// As inverse_dynamics on a tree, returning (τ, λ).
 template <class S, pfaffian_constraint C>
@@ -432,12 +439,16 @@ auto inverse_dynamics_with_forces(const tree<S>& t, const C& c, rne_options o = 
 }
 
 /// With the joints' friction τ_f(q̇) (dynamics/friction.hpp, dynamics/terms.hpp):
-/// project ∘ (rne + friction) ∘ lift, on a chain or a tree.
+/// project ∘ (rne + friction) ∘ lift, on a chain or a tree (on a tree with `evaluate`, as without).
 template <class Model, pfaffian_constraint C>
   requires(std::is_same_v<Model, tree<typename Model::scalar_type>> ||
            std::is_same_v<Model, chain<typename Model::scalar_type, Model::size_at_compile_time>>)
 auto inverse_dynamics(const Model& m, const C& c, rne_options o, friction_fn f) {
-  return detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), project(c));
+  using S = typename Model::scalar_type;
+  if constexpr (std::is_same_v<Model, tree<S>>)  // with evaluate, as without friction
+    return detail::with_tree_evaluate<S, C>(detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), project(c)));
+  else
+    return detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), project(c));
 }
 /// As inverse_dynamics with friction, returning (τ, λ).
 template <class Model, pfaffian_constraint C>

@@ -300,8 +300,11 @@ class aba_fn : public stage_tag {
   template <class Q, class QD, class TAU, applied_forces F>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                   const F& fx) const {
-    detail::check_size(tau, dof(), "tau");
-    return (*this)(q, qd, detail::plus_applied(tau, fx, q));
+    using T = promote_t<promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>, typename TAU::Scalar>,
+                        detail::applied_scalar_t<F, Q>>;
+    vecN<T, dynamic> out(dof());  // q̈ the one allocation: τ + Q_ext in evaluate's stack scratch
+    evaluate(q, qd, tau, fx, out);
+    return out;
   }
   /// …into qdd (of the model's, the inputs' and Q_ext's promoted scalar): the call's numbers
   /// bit for bit; τ + Q_ext in stack scratch, so no allocation where the applied forces write

@@ -24,8 +24,8 @@
 /// chain or a tree of any size, no heap allocation once both have their size (ABA's scratch
 /// beyond its stack part, 51 bodies, is a block its thread keeps: detail/small_buffer.hpp).
 /// The call runs the same steps in a workspace its thread keeps (detail::thread_kept): in the
-/// model's scalar and without friction or applied forces (which form τ − τ_f and τ + Q_ext as
-/// new vectors), q̈ is its one allocation.
+/// model's scalar, with friction and applied forces too (those that write into storage, as
+/// external_wrenches does), q̈ is its one allocation.
 #include <cmath>
 #include <optional>
 
@@ -100,21 +100,29 @@ class forward_dynamics_fn : public stage_tag {
                   const Eigen::MatrixBase<TAU>& tau) const {
     using X = typename Q::Scalar;
     using T = promote_t<promote_t<promote_t<S, X>, typename QD::Scalar>, typename TAU::Scalar>;
-    detail::check_size(tau, n_, "tau");
-    detail::check_finite(tau, "tau");
-    if (friction_) {  // τ − τ_f(q̇): what is left to accelerate the bodies
-      const vecN<T, N> net = tau.template cast<T>() - (*friction_)(qd).template cast<T>();
-      return solve<T>(q, qd, net);
+    if constexpr (in_model_scalar<Q, QD, TAU>) {  // evaluate's steps: q̈ the one allocation
+      return into_new<S>([&](auto& ws, auto& qdd) { evaluate(q, qd, tau, ws, qdd); });
+    } else {
+      detail::check_size(tau, n_, "tau");
+      detail::check_finite(tau, "tau");
+      if (friction_) {  // τ − τ_f(q̇): what is left to accelerate the bodies
+        const vecN<T, N> net = tau.template cast<T>() - (*friction_)(qd).template cast<T>();
+        return solve<T>(q, qd, net);
+      }
+      return solve<T>(q, qd, tau);
     }
-    return solve<T>(q, qd, tau);
   }
 
   /// With applied forces (external wrenches, dynamics/wrench.hpp): q̈ for τ + Q_ext(q).
   template <class Q, class QD, class TAU, applied_forces F>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                   const F& fx) const {
-    detail::check_size(tau, n_, "tau");
-    return (*this)(q, qd, detail::plus_applied(tau, fx, q));
+    if constexpr (in_model_scalar<Q, QD, TAU> && std::is_same_v<detail::applied_scalar_t<F, Q>, S>) {
+      return into_new<S>([&](auto& ws, auto& qdd) { evaluate(q, qd, tau, fx, ws, qdd); });
+    } else {
+      detail::check_size(tau, n_, "tau");
+      return (*this)(q, qd, detail::plus_applied(tau, fx, q));
+    }
   }
 
   /// q̈ into qdd (resized to n), with M, h, M's factor and τ − τ_f in ws: the call's numbers,
@@ -162,20 +170,27 @@ class forward_dynamics_fn : public stage_tag {
   }
 
  private:
-  /// q̈ = M⁻¹(τ − h) as a new vector (any scalar T: the inputs' promoted one). On a run-time
-  /// size, M, h and the factor go into a workspace its thread keeps (detail::thread_kept), so
-  /// that in the model's scalar q̈ is the only allocation; a fixed size needs no heap.
-  template <class T, class Q, class QD, class TAU>
-  vecN<T, N> solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau) const {
+  template <class Q, class QD, class TAU>
+  static constexpr bool in_model_scalar = std::is_same_v<typename Q::Scalar, S> &&
+                                          std::is_same_v<typename QD::Scalar, S> && std::is_same_v<typename TAU::Scalar, S>;
+  /// run(ws, q̈) into a new q̈ of scalar T, with a workspace its thread keeps on a run-time size
+  /// (detail::thread_kept; a fixed size needs no heap): q̈ is the only allocation.
+  template <class T, class Run>
+  vecN<T, N> into_new(const Run& run) const {
     vecN<T, N> qdd;
     if constexpr (N == dynamic) {
       detail::thread_kept<forward_dynamics_scratch<T, N>> ws;
-      solve_into(q, qd, tau, *ws, qdd);
+      run(*ws, qdd);
     } else {
       forward_dynamics_scratch<T, N> ws;
-      solve_into(q, qd, tau, ws, qdd);
+      run(ws, qdd);
     }
     return qdd;
+  }
+  /// q̈ = M⁻¹(τ − h) as a new vector (any scalar T: the inputs' promoted one).
+  template <class T, class Q, class QD, class TAU>
+  vecN<T, N> solve(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau) const {
+    return into_new<T>([&](auto& ws, auto& qdd) { solve_into(q, qd, tau, ws, qdd); });
   }
   /// q̈ = M⁻¹(τ − h): CRBA + LDLᵀ or ABA as the options say, into qdd (T: qdd's scalar).
   template <class Q, class QD, class TAU, class T>

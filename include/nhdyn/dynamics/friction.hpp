@@ -210,6 +210,23 @@ struct sum_fn : stage_tag {
     Eigen::Matrix<T, Eigen::Dynamic, 1> out = x.template cast<T>() + y.template cast<T>();
     return out;
   }
+  /// a(q, q̇, q̈) + b(q̇) into v (a's evaluate, then b's add_to: the ξ form's numbers, bit for
+  /// bit, without its vectors), for a b that reads q̇ alone (friction), so v may be q̈'s storage.
+  template <class Q, class QD, class QDD, class V>
+    requires requires(const A& x, const B& y, const Q& q, const QD& qd, const QDD& qdd, Eigen::MatrixBase<V>& v) {
+      x.evaluate(q, qd, qdd, v);
+      y.add_to(qd, v);
+    }
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
+                Eigen::MatrixBase<V>& v) const {
+    a.evaluate(q, qd, qdd, v);
+    b.add_to(qd, v);
+  }
+  int dof() const
+    requires requires(const A& x) { x.dof(); }
+  {
+    return a.dof();
+  }
   template <class Xi>
     requires requires(const Xi& x) {
       x.q;

@@ -87,10 +87,16 @@ void add_applied(const F& fx, const Q& q, Eigen::MatrixBase<V>& v) {
   }
 }
 /// v − Q_ext(q), N entries in the common scalar: what rne returns with applied forces.
+/// A new v of that type is moved in, not copied: a call that forms v allocates it only.
 template <int N, class V, class F, class Q>
-auto minus_applied(const V& v, const F& fx, const Q& q) {
-  using R = promote_t<typename V::Scalar, applied_scalar_t<F, Q>>;
-  vecN<R, N> out = v.template cast<R>();
+auto minus_applied(V&& v, const F& fx, const Q& q) {
+  using W = std::remove_cvref_t<V>;
+  using R = promote_t<typename W::Scalar, applied_scalar_t<F, Q>>;
+  vecN<R, N> out;
+  if constexpr (std::is_same_v<W, vecN<R, N>> && !std::is_lvalue_reference_v<V>)
+    out = std::move(v);
+  else
+    out = v.template cast<R>();
   add_applied<-1>(fx, q, out);
   return out;
 }
