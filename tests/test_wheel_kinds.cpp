@@ -901,3 +901,46 @@ TEST_CASE("inverse_dynamics with friction on a tree: evaluate and the call = lif
     }, *r.constraint);
   }
 }
+
+TEST_CASE("inverse_dynamics_with_forces on a tree: evaluate into reused (tau, lambda) = the call; tau = "
+          "inverse_dynamics' bit for bit; lambda = the composition's and makes v = E tau + A^T lambda",
+          "[wheel_kinds]") {
+  std::mt19937 rng(2028);
+  constrained_forces<double> out;  // reused across the robot files: sizes change
+  out.tau = VectorXd::Constant(40, 7.0), out.lambda = VectorXd::Constant(1, 7.0);
+  for (const char* file : every_robot_file) {
+    INFO(file);
+    const auto r = load(file);
+    std::visit([&](const auto& c) {
+      const auto& t = r.model;
+      const int n = t.dof();
+      std::vector<joint_friction> laws(std::size_t(n), joint_friction{0.25, 0.1, -0.1});
+      const friction_fn fr(laws, coulomb_law::smooth(0.05));
+      const auto run = [&](const auto& idf, const auto& id, const auto& by_hand, const auto& dyn) {
+        for (int trial = 0; trial < 3; ++trial) {
+          const VectorXd q = random_q(n, rng), eta = random_vec(c.m(), rng), eta_dot = random_vec(c.m(), rng, 2);
+          idf.evaluate(q, eta, eta_dot, out);
+          const auto call = idf(q, eta, eta_dot);
+          CHECK((out.tau.array() == call.tau.array()).all());
+          CHECK((out.lambda.array() == call.lambda.array()).all());
+          const VectorXd tau = id(q, eta, eta_dot);
+          CHECK((out.tau.array() == tau.array()).all());
+          const auto hand = by_hand(q, eta, eta_dot);  // the stages' calls: τ without the lift's memo
+          REQUIRE(hand.lambda.size() == c.k());
+          CHECK((out.lambda - VectorXd(hand.lambda)).cwiseAbs().maxCoeff() <= 1e-10 * (1 + out.lambda.cwiseAbs().maxCoeff()));
+          // v = E τ + Aᵀ λ: v the stationary robot's rne at the lifted state
+          const VectorXd qd = apply_S(c, q, eta);
+          const VectorXd qdd = c.S(q) * eta_dot + apply_Sdot(c, q, qd, eta);
+          const VectorXd v = dyn(q, qd, qdd);
+          const VectorXd recon = input_map(c, q) * out.tau + c.A(q).transpose() * out.lambda;
+          CHECK((recon - v).cwiseAbs().maxCoeff() <= 1e-9 * (1 + v.cwiseAbs().maxCoeff()));
+        }
+      };
+      run(inverse_dynamics_with_forces(t, c), inverse_dynamics(t, c), lift(c) | rne(t) | constraint_forces(c),
+          [&](const auto& q, const auto& qd, const auto& qdd) { return VectorXd(rne(t)(q, qd, qdd)); });
+      run(inverse_dynamics_with_forces(t, c, {}, fr), inverse_dynamics(t, c, {}, fr),
+          lift(c) | (rne(t) + fr) | constraint_forces(c),
+          [&](const auto& q, const auto& qd, const auto& qdd) { return VectorXd(rne(t)(q, qd, qdd) + fr(qd)); });
+    }, *r.constraint);
+  }
+}

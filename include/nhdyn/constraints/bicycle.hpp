@@ -97,16 +97,20 @@ struct bicycle {
 
   template <class Q>
   auto A(const Eigen::MatrixBase<Q>& q) const {
-    using T = promote_t<Sc, typename Q::Scalar>;
+    return detail::A_by_A_into(*this, q);
+  }
+  /// A(q) into a (resized to 2 × n: no allocation once it has that size).
+  template <class Q, class Am>
+  void A_into(const Eigen::MatrixBase<Q>& q, Eigen::PlainObjectBase<Am>& a) const {
+    using T = typename Am::Scalar;
     const auto p = detail::sincos_of(T(q(heading)));
     const auto d = detail::sincos_of(T(steer_sign * T(q(steer))));
-    matrix<T, k_at_compile_time, N> a = matrix<T, k_at_compile_time, N>::Zero(2, n);
+    a.setZero(2, n);
     a(0, x) = -p.s;
     a(0, y) = p.c;
     a(1, x) = -d.s * p.c;
     a(1, y) = -d.s * p.s;
     a(1, heading) = T(wheelbase) * d.c;
-    return a;
   }
   /// S(q), filled directly (one sin/cos of ψ and of δ; the layout of S_times).
   template <class Q>
@@ -145,6 +149,21 @@ struct bicycle {
     for (int j = 0, c = 2; j < n; ++j)
       if (!is_base_or_steer(j)) e(j, c++) = T(1);
     return e;
+  }
+  /// E τ into out (n entries) without forming E: the traction along (cos ψ, sin ψ), τ at the
+  /// steering joint and the other joints.
+  template <class Q, class Tau, class Out>
+  void E_times_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<Tau>& tau, Eigen::MatrixBase<Out>& out) const {
+    using T = typename Out::Scalar;
+    detail::check_size(tau, n - 2, "tau");
+    detail::check_size(out, n, "E tau");
+    const auto p = detail::sincos_of(T(q(heading)));
+    out.setZero();
+    out(x) = p.c * T(tau(0));
+    out(y) = p.s * T(tau(0));
+    out(steer) = T(tau(1));
+    for (int j = 0, c = 2; j < n; ++j)
+      if (!is_base_or_steer(j)) out(j) = T(tau(c++));
   }
   /// q̇ = S(q) η without forming S.
   template <class Q, class Et>

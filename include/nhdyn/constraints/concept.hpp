@@ -159,6 +159,14 @@ auto S_by_S_into(const C& c, const Eigen::MatrixBase<Q>& q) {
   return s;
 }
 
+/// A(q) as a new matrix (k × n) from a constraint's A_into.
+template <class C, class Q>
+auto A_by_A_into(const C& c, const Eigen::MatrixBase<Q>& q) {
+  matrix<promote_t<typename C::scalar_type, typename Q::Scalar>, C::k_at_compile_time, C::n_at_compile_time> a;
+  c.A_into(q, a);
+  return a;
+}
+
 /// The entries of an n × m matrix S that the products below read, by column: column c's rows
 /// are rows[start[c]] … rows[start[c + 1] − 1]. For a floating-point S they are its nonzero
 /// entries (a term 0·x adds nothing where x is finite: the products equal the dense ones up to

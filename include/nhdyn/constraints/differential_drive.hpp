@@ -153,11 +153,17 @@ struct differential_drive {
   /// (AAᵀ = 1), so for E = S the constraint force is λ = A v (stages.hpp).
   template <class Q, class V>
   auto A_times(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
-    using T = promote_t<promote_t<Sc, typename Q::Scalar>, typename V::Scalar>;
-    const auto p = sincos_psi(T(q(heading)));
-    vecN<T, k_at_compile_time> out(1);
-    out(0) = p.c * T(v(y)) - p.s * T(v(x));
+    vecN<promote_t<promote_t<Sc, typename Q::Scalar>, typename V::Scalar>, k_at_compile_time> out;
+    A_times_into(q, v, out);
     return out;
+  }
+  /// A v into out (resized to 1).
+  template <class Q, class V, class Out>
+  void A_times_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v, Eigen::PlainObjectBase<Out>& out) const {
+    using T = typename Out::Scalar;
+    const auto p = sincos_psi(T(q(heading)));
+    out.resize(1);
+    out(0) = p.c * T(v(y)) - p.s * T(v(x));
   }
   /// Sᵀ v without forming S.
   template <class Q, class V>

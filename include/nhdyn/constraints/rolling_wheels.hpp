@@ -110,9 +110,14 @@ struct rolling_wheels {
 
   template <class Q>
   auto A(const Eigen::MatrixBase<Q>& q) const {
-    using T = promote_t<Sc, typename Q::Scalar>;
+    return detail::A_by_A_into(*this, q);
+  }
+  /// A(q) into a (resized to 3 × n: no allocation once it has that size).
+  template <class Q, class Am>
+  void A_into(const Eigen::MatrixBase<Q>& q, Eigen::PlainObjectBase<Am>& a) const {
+    using T = typename Am::Scalar;
     const auto p = detail::sincos_of(T(q(heading)));
-    matrix<T, k_at_compile_time, N> a = matrix<T, k_at_compile_time, N>::Zero(3, n);
+    a.setZero(3, n);
     a(0, x) = -p.s;
     a(0, y) = p.c;
     a(0, heading) = T(axle_x);
@@ -124,7 +129,6 @@ struct rolling_wheels {
     a(2, heading) = T(-right_y);
     a(1, left) = T(-radius * left_sign);
     a(2, right) = T(-radius * right_sign);
-    return a;
   }
   /// S(q), filled directly (one sin/cos of ψ; the layout of S_times).
   template <class Q>
@@ -164,6 +168,18 @@ struct rolling_wheels {
     for (int j = 0, c = 2; j < n; ++j)
       if (!is_base_or_wheel(j)) e(j, c++) = T(1);
     return e;
+  }
+  /// E τ into out (n entries) without forming E: τ at the wheel joints and the other joints.
+  template <class Q, class Tau, class Out>
+  void E_times_into(const Eigen::MatrixBase<Q>&, const Eigen::MatrixBase<Tau>& tau, Eigen::MatrixBase<Out>& out) const {
+    using T = typename Out::Scalar;
+    detail::check_size(tau, n - 3, "tau");
+    detail::check_size(out, n, "E tau");
+    out.setZero();
+    out(left) = T(tau(0));
+    out(right) = T(tau(1));
+    for (int j = 0, c = 2; j < n; ++j)
+      if (!is_base_or_wheel(j)) out(j) = T(tau(c++));
   }
   /// q̇ = S(q) η without forming S.
   template <class Q, class Et>

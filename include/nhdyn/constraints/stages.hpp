@@ -242,39 +242,94 @@ project_fn<C> project(C c) {
   return project_fn<C>(std::move(c));
 }
 
+namespace detail {
+/// What λ's solve keeps from call to call: A(q), AAᵀ, its factor and v − Eτ.
+template <class T, int N, int K>
+struct lambda_scratch {
+  matrix<T, K, N> A;
+  matrix<T, K, K> AAt;
+  ldlt<T, K> factor;
+  vecN<T, N> r;
+};
+}  // namespace detail
+
 /// (q, v) ↦ (τ, λ): the projection and the constraint forces λ = (AAᵀ)⁻¹ A (v − Eτ).
 template <class C>
 class constraint_forces_fn : public stage_tag {
  public:
   explicit constraint_forces_fn(C c) : c_(std::move(c)), p_(c_) {}
+  const C& constraint() const { return c_; }
 
   template <class Q, class V>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v) const {
-    const auto tau = p_(q, v);  // checks q and v
+    auto tau = p_(q, v);  // checks q and v
     using T = typename decltype(tau)::Scalar;
-    constexpr int M = C::m_at_compile_time, K = C::k_at_compile_time;
-    constrained_forces<T, M, K> out;
-    if constexpr (!has_input_map<C, Q> && requires { c_.A_times(q, v); }) {
-      // E = S: A E τ = A S τ = 0, so λ = (AAᵀ)⁻¹ A v, and a constraint with orthonormal rows
-      // (AAᵀ = I: differential_drive) gives it as a structured product, no matrix formed.
-      out.lambda = c_.A_times(q, v);
-      out.tau = tau;
-      return out;
-    }
-    const auto A = c_.A(q);
-    const vecN<T, C::n_at_compile_time> r = v.template cast<T>() - (input_map(c_, q) * tau).template cast<T>();
-    const matrix<T, K, K> AAt = (A * A.transpose()).template cast<T>();
-    out.lambda = c_.k() == 0 ? vecN<T, K>(0)
-                             : vecN<T, K>(ldlt_factor<T, K>(AAt, "AAᵀ").solve((A.template cast<T>() * r).eval()));
-    out.tau = tau;
+    constrained_forces<T, C::m_at_compile_time, C::k_at_compile_time> out;
+    lambda_into(q, v, tau, out.lambda);
+    out.tau = std::move(tau);
     return out;
   }
   template <class X, int N>
   auto operator()(const generalized_forces<X, N>& f) const {
     return (*this)(f.q, f.v);
   }
+  /// (τ, λ) into out from (q, v) and the lift's memo: τ as project's `into` forms it (the
+  /// inverse dynamics' τ, bit for bit), then λ as the call forms it from that τ. No allocation
+  /// once out has its sizes where the constraint projects into given storage and forms A(q) and
+  /// E τ there (every built-in base constraint: `A_into`, `E_times_into`, differential_drive's
+  /// `A_times_into`); A, AAᵀ and the factor in a scratch the thread keeps.
+  template <class Q, class V, class Memo, class T, int M, int K>
+  void into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v, const Memo& memo,
+            constrained_forces<T, M, K>& out) const {
+    out.tau.resize(actuator_count(c_));
+    p_.into(q, v, memo, out.tau);
+    lambda_into(q, v, out.tau, out.lambda);
+  }
 
  private:
+  /// λ = (AAᵀ)⁻¹ A (v − Eτ) into lambda (k entries). With E = S (no input map) A E τ = A S τ =
+  /// 0, so λ = (AAᵀ)⁻¹ A v, and a constraint with orthonormal rows (AAᵀ = I: differential_drive)
+  /// gives A v as a structured product, no matrix formed.
+  template <class Q, class V, class Tau, class L>
+  void lambda_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v, const Tau& tau, L& lambda) const {
+    using T = typename L::Scalar;
+    constexpr int N = C::n_at_compile_time, K = C::k_at_compile_time;
+    if constexpr (!has_input_map<C, Q> && requires { c_.A_times_into(q, v, lambda); }) {
+      c_.A_times_into(q, v, lambda);
+    } else {
+      lambda.resize(c_.k());
+      if (c_.k() == 0) return;
+      const auto solve = [&](detail::lambda_scratch<T, N, K>& ws) {
+        using TA = typename decltype(c_.A(q))::Scalar;  // A's own scalar: into where it is λ's
+        if constexpr (std::is_same_v<TA, T> && requires { c_.A_into(q, ws.A); })
+          c_.A_into(q, ws.A);
+        else
+          ws.A = c_.A(q).template cast<T>();
+        if constexpr (has_input_map<C, Q>) {
+          ws.r.resize(c_.dof());
+          if constexpr (has_E_times_into<C, Q, Tau, vecN<T, N>>)
+            c_.E_times_into(q, tau, ws.r);
+          else
+            ws.r = (input_map(c_, q) * tau).template cast<T>();
+          ws.r = v.template cast<T>() - ws.r;
+        } else {
+          ws.r = v.template cast<T>();
+        }
+        ws.AAt.noalias() = ws.A * ws.A.transpose();
+        ldlt_factor_into<T, K>(ws.AAt, ws.factor, "AAᵀ");
+        lambda.noalias() = ws.A * ws.r;
+        ws.factor.solve_in_place(lambda);
+      };
+      if constexpr (N == dynamic || K == dynamic) {
+        detail::thread_kept<detail::lambda_scratch<T, N, K>> ws;
+        solve(*ws);
+      } else {
+        detail::lambda_scratch<T, N, K> ws;
+        solve(ws);
+      }
+    }
+  }
+
   C c_;
   project_fn<C> p_;
 };
@@ -352,6 +407,8 @@ auto nh_tree_pipeline(const tree<S>& t, const C& c, rne_options o, Out out) {
 /// into stack scratch (beyond 256 joints, a heap block the thread keeps), rne.evaluate writes
 /// v over q̈, project.into writes τ into the caller's vector. No allocation where the constraint lifts and projects
 /// into given storage (every built-in base constraint; wheeled_base with k·|η ∩ W| ≤ 24).
+/// inverse_dynamics_with_forces takes the same form, its last stage constraint_forces:
+/// `evaluate(q, η, η̇, out)` writes τ and λ into a constrained_forces (its into).
 template <class Composed, class C>
 struct tree_inverse_dynamics : Composed {
   explicit tree_inverse_dynamics(Composed c) : Composed(std::move(c)) {}
@@ -363,9 +420,11 @@ struct tree_inverse_dynamics : Composed {
   template <class... X>
   decltype(auto) operator()(X&&... x) const {
     if constexpr (call_evaluates<X...>()) {
-      std::decay_t<decltype(Composed::operator()(std::forward<X>(x)...))> tau(actuator_count(this->f.constraint()));
-      evaluate(std::forward<X>(x)..., tau);
-      return tau;
+      using R = std::decay_t<decltype(Composed::operator()(std::forward<X>(x)...))>;
+      R out;
+      if constexpr (std::is_base_of_v<Eigen::MatrixBase<R>, R>) out.resize(actuator_count(this->f.constraint()));
+      evaluate(std::forward<X>(x)..., out);
+      return out;
     } else {
       return Composed::operator()(std::forward<X>(x)...);
     }
@@ -387,6 +446,8 @@ struct tree_inverse_dynamics : Composed {
   static constexpr bool evaluates_into() {
     if constexpr (std::is_base_of_v<Eigen::MatrixBase<R>, R>)
       return std::is_same_v<typename R::Scalar, tau_scalar<Q, E, ED>>;
+    else if constexpr (requires(R r) { r.tau; r.lambda; })  // constrained_forces: (τ, λ)
+      return std::is_same_v<typename decltype(R::tau)::Scalar, tau_scalar<Q, E, ED>>;
     else
       return false;
   }
@@ -396,17 +457,33 @@ struct tree_inverse_dynamics : Composed {
   template <class Q, class E, class ED, class Tau>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
                 Eigen::MatrixBase<Tau>& tau) const {
+    static_assert(std::is_same_v<typename Tau::Scalar, tau_scalar<Q, E, ED>>,
+                  "tau's scalar is the promoted scalar of the constraint, q, eta and eta_dot");
+    run<typename Tau::Scalar>(q, eta, eta_dot, tau);
+  }
+  /// (τ, λ) into out (inverse_dynamics_with_forces): bit for bit the call's.
+  template <class Q, class E, class ED, class T, int M, int K>
+  void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
+                constrained_forces<T, M, K>& out) const {
+    static_assert(std::is_same_v<T, tau_scalar<Q, E, ED>>,
+                  "out's scalar is the promoted scalar of the constraint, q, eta and eta_dot");
+    run<T>(q, eta, eta_dot, out);
+  }
+
+ private:
+  /// lift.into, rne.evaluate, then the last stage's into (τ, or τ and λ).
+  template <class T, class Q, class E, class ED, class Out>
+  void run(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<ED>& eta_dot,
+           Out& out) const {
     const auto& projection = this->f;
     const auto& dynamics = this->g.f;
     const auto& lifting = this->g.g;
-    using T = typename Tau::Scalar;
-    static_assert(std::is_same_v<T, tau_scalar<Q, E, ED>>, "tau's scalar is the promoted scalar of the constraint, q, eta and eta_dot");
     const int n = dynamics.dof();
     small_buffer<T, dynamic, 512> store(2 * n);  // q̇, then q̈ and v
     Eigen::Map<vecN<T, dynamic>> qd(store.data(), n), v(store.data() + n, n);
     const auto memo = lifting.into(q, eta, eta_dot, qd, v);  // q̈ into v's storage
     dynamics.evaluate(q, qd, v, v);                          // v over q̈
-    projection.into(q, v, memo, tau);
+    projection.into(q, v, memo, out);
   }
 };
 }  // namespace detail
@@ -435,7 +512,7 @@ auto inverse_dynamics(const tree<S>& t, const C& c, rne_options o = {}) {
 /// As inverse_dynamics on a tree, returning (τ, λ).
 template <class S, pfaffian_constraint C>
 auto inverse_dynamics_with_forces(const tree<S>& t, const C& c, rne_options o = {}) {
-  return detail::nh_tree_pipeline(t, c, o, constraint_forces(c));
+  return detail::with_tree_evaluate<S, C>(detail::nh_tree_pipeline(t, c, o, constraint_forces(c)));
 }
 
 /// With the joints' friction τ_f(q̇) (dynamics/friction.hpp, dynamics/terms.hpp):
@@ -455,7 +532,11 @@ template <class Model, pfaffian_constraint C>
   requires(std::is_same_v<Model, tree<typename Model::scalar_type>> ||
            std::is_same_v<Model, chain<typename Model::scalar_type, Model::size_at_compile_time>>)
 auto inverse_dynamics_with_forces(const Model& m, const C& c, rne_options o, friction_fn f) {
-  return detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), constraint_forces(c));
+  using S = typename Model::scalar_type;
+  if constexpr (std::is_same_v<Model, tree<S>>)  // with evaluate, as without friction
+    return detail::with_tree_evaluate<S, C>(detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), constraint_forces(c)));
+  else
+    return detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), constraint_forces(c));
 }
 
 }  // namespace nhdyn

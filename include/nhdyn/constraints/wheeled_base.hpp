@@ -390,14 +390,18 @@ class wheeled_base {
   /// A(q), k × n.
   template <class Q>
   auto A(const Eigen::MatrixBase<Q>& q) const {
-    using T = promote_t<Sc, typename Q::Scalar>;
+    return detail::A_by_A_into(*this, q);
+  }
+  /// A(q) into a (resized to k × n: no allocation once it has that size).
+  template <class Q, class Am>
+  void A_into(const Eigen::MatrixBase<Q>& q, Eigen::PlainObjectBase<Am>& a) const {
+    using T = typename Am::Scalar;
     check_q(q);
     detail::wheel_buffer<T, dynamic> aw(k() * nw());
     rows_at(q, aw.data());
-    matrix<T, dynamic, dynamic> a = matrix<T, dynamic, dynamic>::Zero(k(), n_);
+    a.setZero(k(), n_);
     for (int c = 0; c < nw(); ++c)
       for (int r = 0; r < k(); ++r) a(r, W_[std::size_t(c)]) = aw[r + c * k()];
-    return a;
   }
 
   /// S(q), n × m: unit rows at η's joints, −A_D⁻¹ A_I at D's.
