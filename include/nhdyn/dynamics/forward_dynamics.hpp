@@ -7,7 +7,7 @@
 /// - `fd_method::aba`: Featherstone's articulated-body algorithm (dynamics/aba.hpp), O(n),
 ///   never forming M;
 /// - `fd_method::automatic` (default): ABA from `aba_from` joints on (9: on the benchmark's
-///   chains CRBA + LDLᵀ is 2–18 % faster at 5 and 6 joints, ABA 15 % faster at 12 and 1.9× at
+///   chains CRBA + LDLᵀ is 3–19 % faster at 5 and 6 joints, ABA 17 % faster at 12 and 1.8× at
 ///   24, docs/performance.md), CRBA + LDLᵀ below — unless M's diagonally scaled pivots show it ill-conditioned (scaled ratio past
 ///   √(1/ε) of the scalar: 6.7e7 in double, 4.1e3 in float, where LDLᵀ keeps fewer than half
 ///   the digits): then ABA answers, which is more accurate there (docs/accuracy.md, mass
