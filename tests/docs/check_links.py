@@ -6,7 +6,7 @@ import re
 import sys
 import unicodedata
 
-root = pathlib.Path(sys.argv[1])
+root = pathlib.Path(sys.argv[1]).resolve()  # a relative SOURCE_DIR too
 pages = [root / "README.md"] + sorted((root / "docs").glob("*.md"))
 link = re.compile(r"!?\[(?:[^\]\[]|\[[^\]]*\])*\]\(([^)\s]+)(?:\s+\"[^\"]*\")?\)")
 fence = re.compile(r"^(```|~~~)")
