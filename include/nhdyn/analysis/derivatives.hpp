@@ -61,11 +61,6 @@ inline object_tag next_object_tag() {
   return {&last, ++last};
 }
 
-/// Every argument's scalar is S (the evaluate overloads: a reused result is in the model's
-/// scalar, and inputs of another are not silently converted to it).
-template <class S, class... X>
-concept in_scalar = (std::is_same_v<typename X::Scalar, S> && ...);
-
 /// A nonzero S_rc (or Ṡ_rc) of a constraint's S at one q.
 template <class T>
 struct s_nonzero {
@@ -225,15 +220,6 @@ auto& run_time_or_local(Kept& kept, Local& local) {
   else
     return local;
 }
-/// A plain call in the model's scalar: `evaluate` into a result of type R its thread keeps
-/// (detail::thread_kept), then its outputs moved into a new R by take(kept) — the scratch
-/// stays behind for the thread's next call, so the call allocates its output only.
-template <class R, class Evaluate, class Take>
-R kept_call(const Evaluate& evaluate, const Take& take) {
-  thread_kept<R> kept;
-  evaluate(*kept);
-  return take(*kept);
-}
 }  // namespace detail
 
 /// τ and ∂τ/∂(q, η, η̇) of the nonholonomic inverse dynamics, and ∂q̇/∂q of the lift
@@ -310,7 +296,7 @@ class inverse_dynamics_derivatives_fn {
                   const Eigen::MatrixBase<ED>& eta_dot) const {
     using R = nh_derivatives_result<result_scalar<Q, E, ED>, C::m_at_compile_time>;
     if constexpr (detail::in_scalar<S, Q, E, ED>) {
-      return detail::kept_call<R>([&](R& k) { evaluate(q, eta, eta_dot, k); }, [](R& k) { return k.take_outputs(); });
+      return detail::with_kept<R>([&](R& k) { evaluate(q, eta, eta_dot, k); return k.take_outputs(); });
     } else {
       R out;
       run(q, eta, eta_dot, out, [&](const auto& x, const auto& xd, const auto& xdd, auto& r) { r = d_(x, xd, xdd); });
@@ -323,7 +309,7 @@ class inverse_dynamics_derivatives_fn {
                   const external_wrenches_fn<Kin, W>& w) const {
     using R = nh_derivatives_result<promote_t<result_scalar<Q, E, ED>, W>, C::m_at_compile_time>;
     if constexpr (detail::in_scalar<S, Q, E, ED> && std::is_same_v<W, S>) {
-      return detail::kept_call<R>([&](R& k) { evaluate(q, eta, eta_dot, w, k); }, [](R& k) { return k.take_outputs(); });
+      return detail::with_kept<R>([&](R& k) { evaluate(q, eta, eta_dot, w, k); return k.take_outputs(); });
     } else {
       R out;
       run(q, eta, eta_dot, out,
@@ -575,7 +561,7 @@ struct fd_derivatives_result {
 /// (inputs and wrenches in the model's scalar): no heap allocation once out has the tree's size,
 /// on trees of any size (the kernels' scratch beyond its stack part is a block the thread keeps,
 /// detail/small_buffer.hpp). The call in the model's scalar runs evaluate into a result its
-/// thread keeps and moves the outputs out (detail::kept_call): they are its only allocations.
+/// thread keeps and moves the outputs out (detail::with_kept): they are its only allocations.
 template <class S>
 class fd_derivatives_fn {
  public:
@@ -594,7 +580,7 @@ class fd_derivatives_fn {
                   const Eigen::MatrixBase<TAU>& tau) const {
     if constexpr (detail::in_scalar<S, Q, QD, TAU>) {
       using R = fd_derivatives_result<S>;
-      return detail::kept_call<R>([&](R& k) { evaluate(q, qd, tau, k); }, [](R& k) { return k.take_outputs(); });
+      return detail::with_kept<R>([&](R& k) { evaluate(q, qd, tau, k); return k.take_outputs(); });
     } else {
       const auto qdd = fd_(q, qd, tau);
       return finish(qdd, d_(q, qd, qdd));
@@ -605,7 +591,7 @@ class fd_derivatives_fn {
                   const external_wrenches_fn<Kin, W>& w) const {
     if constexpr (detail::in_scalar<S, Q, QD, TAU> && std::is_same_v<W, S>) {
       using R = fd_derivatives_result<S>;
-      return detail::kept_call<R>([&](R& k) { evaluate(q, qd, tau, w, k); }, [](R& k) { return k.take_outputs(); });
+      return detail::with_kept<R>([&](R& k) { evaluate(q, qd, tau, w, k); return k.take_outputs(); });
     } else {
       const auto qdd = fd_(q, qd, tau, w);
       return finish(qdd, d_(q, qd, qdd, w));
@@ -715,7 +701,7 @@ class nh_fd_derivatives_fn {
                   const Eigen::MatrixBase<TAU>& tau) const {
     if constexpr (detail::in_scalar<S, Q, E, TAU>) {
       using R = nh_fd_derivatives_result<S, C::m_at_compile_time>;
-      return detail::kept_call<R>([&](R& k) { evaluate(q, eta, tau, k); }, [](R& k) { return k.take_outputs(); });
+      return detail::with_kept<R>([&](R& k) { evaluate(q, eta, tau, k); return k.take_outputs(); });
     } else {
       return own_result(q, tau, fd_(q, eta, tau), [&](const auto& ed) { return id_(q, eta, ed); });
     }
@@ -725,7 +711,7 @@ class nh_fd_derivatives_fn {
                   const external_wrenches_fn<Kin, W>& w) const {
     if constexpr (detail::in_scalar<S, Q, E, TAU> && std::is_same_v<W, S>) {
       using R = nh_fd_derivatives_result<S, C::m_at_compile_time>;
-      return detail::kept_call<R>([&](R& k) { evaluate(q, eta, tau, w, k); }, [](R& k) { return k.take_outputs(); });
+      return detail::with_kept<R>([&](R& k) { evaluate(q, eta, tau, w, k); return k.take_outputs(); });
     } else {
       return own_result(q, tau, fd_(q, eta, tau, w), [&](const auto& ed) { return id_(q, eta, ed, w); });
     }

@@ -131,9 +131,11 @@ class nh_forward_dynamics_fn : public stage_tag {
                   const F& fx) const {
     if constexpr (N == dynamic || M == dynamic) {  // evaluate into a result its thread keeps, Q_ext too
       using T0 = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
-      detail::thread_kept<nh_forward_dynamics_result<promote_t<T0, detail::applied_scalar_t<F, Q>>, N, M>> kept;
-      evaluate(q, eta, tau, fx, *kept);
-      return decltype((*kept).eta_dot)((*kept).eta_dot);
+      using result = nh_forward_dynamics_result<promote_t<T0, detail::applied_scalar_t<F, Q>>, N, M>;
+      return detail::with_kept<result>([&](result& kept) {
+        evaluate(q, eta, tau, fx, kept);
+        return kept.eta_dot;
+      });
     } else {
       detail::check_size(q, c_.dof(), "q");
       const auto Qx = fx.generalized_force(q);
@@ -191,15 +193,10 @@ class nh_forward_dynamics_fn : public stage_tag {
              const QX* Qx) const {
     using T0 = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
     using result = nh_forward_dynamics_result<promote_t<T0, typename QX::Scalar>, N, M>;
-    if constexpr (N == dynamic || M == dynamic) {
-      detail::thread_kept<result> kept;
-      solve_into(q, eta, tau, Qx, *kept);
-      return decltype((*kept).eta_dot)((*kept).eta_dot);
-    } else {
-      result out;
+    return detail::with_kept<result, N == dynamic || M == dynamic>([&](result& out) {
       solve_into(q, eta, tau, Qx, out);
-      return std::move(out.eta_dot);
-    }
+      return out.eta_dot;
+    });
   }
 
   /// S(q) into out.S (zeros, then the entries the constraint writes, or the constraint's S(q))

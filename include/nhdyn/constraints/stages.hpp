@@ -320,13 +320,7 @@ class constraint_forces_fn : public stage_tag {
         lambda.noalias() = ws.A * ws.r;
         ws.factor.solve_in_place(lambda);
       };
-      if constexpr (N == dynamic || K == dynamic) {
-        detail::thread_kept<detail::lambda_scratch<T, N, K>> ws;
-        solve(*ws);
-      } else {
-        detail::lambda_scratch<T, N, K> ws;
-        solve(ws);
-      }
+      detail::with_kept<detail::lambda_scratch<T, N, K>, N == dynamic || K == dynamic>(solve);
     }
   }
 

@@ -219,4 +219,19 @@ class thread_kept {
   T* obj_ = nullptr;
 };
 
+/// run(T&) on the T its thread keeps (thread_kept) when Kept — a run-time size, whose storage
+/// is worth keeping — else on a T of its own (a fixed size: on the stack); returns what run
+/// returns, by value. A plain call runs its `evaluate` steps this way, so that what it returns
+/// is its only allocation.
+template <class T, bool Kept = true, class Run>
+auto with_kept(Run&& run) {
+  if constexpr (Kept) {
+    thread_kept<T> kept;
+    return run(*kept);
+  } else {
+    T local;
+    return run(local);
+  }
+}
+
 }  // namespace nhdyn::detail

@@ -100,7 +100,7 @@ class forward_dynamics_fn : public stage_tag {
                   const Eigen::MatrixBase<TAU>& tau) const {
     using X = typename Q::Scalar;
     using T = promote_t<promote_t<promote_t<S, X>, typename QD::Scalar>, typename TAU::Scalar>;
-    if constexpr (in_model_scalar<Q, QD, TAU>) {  // evaluate's steps: q̈ the one allocation
+    if constexpr (detail::in_scalar<S, Q, QD, TAU>) {  // evaluate's steps: q̈ the one allocation
       return into_new<S>([&](auto& ws, auto& qdd) { evaluate(q, qd, tau, ws, qdd); });
     } else {
       detail::check_size(tau, n_, "tau");
@@ -117,7 +117,7 @@ class forward_dynamics_fn : public stage_tag {
   template <class Q, class QD, class TAU, applied_forces F>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                   const F& fx) const {
-    if constexpr (in_model_scalar<Q, QD, TAU> && std::is_same_v<detail::applied_scalar_t<F, Q>, S>) {
+    if constexpr (detail::in_scalar<S, Q, QD, TAU> && std::is_same_v<detail::applied_scalar_t<F, Q>, S>) {
       return into_new<S>([&](auto& ws, auto& qdd) { evaluate(q, qd, tau, fx, ws, qdd); });
     } else {
       detail::check_size(tau, n_, "tau");
@@ -129,8 +129,7 @@ class forward_dynamics_fn : public stage_tag {
   /// bit for bit; storage reused from call to call (see the file comment). Inputs in the model's
   /// scalar; qdd must not alias them.
   template <class Q, class QD, class TAU>
-    requires std::is_same_v<typename Q::Scalar, S> && std::is_same_v<typename QD::Scalar, S> &&
-             std::is_same_v<typename TAU::Scalar, S>
+    requires detail::in_scalar<S, Q, QD, TAU>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                 forward_dynamics_scratch<S, N>& ws, vecN<S, N>& qdd) const {
     detail::check_size(q, n_, "q");  // before qdd is resized: an aliased input of the wrong size
@@ -149,8 +148,7 @@ class forward_dynamics_fn : public stage_tag {
   /// call's numbers bit for bit; τ + Q_ext in ws.net, so no allocation where the applied forces
   /// write into storage (external_wrenches does).
   template <class Q, class QD, class TAU, applied_forces F>
-    requires std::is_same_v<typename Q::Scalar, S> && std::is_same_v<typename QD::Scalar, S> &&
-             std::is_same_v<typename TAU::Scalar, S> && std::is_same_v<detail::applied_scalar_t<F, Q>, S>
+    requires detail::in_scalar<S, Q, QD, TAU> && std::is_same_v<detail::applied_scalar_t<F, Q>, S>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                 const F& fx, forward_dynamics_scratch<S, N>& ws, vecN<S, N>& qdd) const {
     detail::check_size(q, n_, "q");
@@ -170,21 +168,12 @@ class forward_dynamics_fn : public stage_tag {
   }
 
  private:
-  template <class Q, class QD, class TAU>
-  static constexpr bool in_model_scalar = std::is_same_v<typename Q::Scalar, S> &&
-                                          std::is_same_v<typename QD::Scalar, S> && std::is_same_v<typename TAU::Scalar, S>;
   /// run(ws, q̈) into a new q̈ of scalar T, with a workspace its thread keeps on a run-time size
   /// (detail::thread_kept; a fixed size needs no heap): q̈ is the only allocation.
   template <class T, class Run>
   vecN<T, N> into_new(const Run& run) const {
     vecN<T, N> qdd;
-    if constexpr (N == dynamic) {
-      detail::thread_kept<forward_dynamics_scratch<T, N>> ws;
-      run(*ws, qdd);
-    } else {
-      forward_dynamics_scratch<T, N> ws;
-      run(ws, qdd);
-    }
+    detail::with_kept<forward_dynamics_scratch<T, N>, N == dynamic>([&](auto& ws) { run(ws, qdd); });
     return qdd;
   }
   /// q̈ = M⁻¹(τ − h) as a new vector (any scalar T: the inputs' promoted one).

@@ -100,4 +100,11 @@ struct promote {
 template <class M, class X>
 using promote_t = typename promote<M, X>::type;
 
+namespace detail {
+/// Every argument's scalar is S (the evaluate forms: a reused result is in the model's scalar,
+/// and inputs of another are not silently converted to it).
+template <class S, class... X>
+concept in_scalar = (std::is_same_v<typename X::Scalar, S> && ...);
+}  // namespace detail
+
 }  // namespace nhdyn
