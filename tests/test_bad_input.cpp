@@ -262,6 +262,10 @@ TEST_CASE("bad input: the nonholonomic stages check sizes and finiteness of q, e
   CHECK_THROWS_AS(differential_drive<double>(3, 0, 1, 5), model_error);
   CHECK_THROWS_AS(differential_drive<double>(3, 0, 1, 2, 0.0, 2.0), model_error);
   CHECK_THROWS_AS(differential_drive<double>(3, 0, 1, 2, nan_), model_error);
+  // every flaw named, one after another: "…: n = 0 but the chain has 5; …: joint index 1 outside 0…-1; …"
+  CHECK(message_of<model_error>([&] { differential_drive<double, 5>(0, 1, 2, 0); }) ==
+        "differential_drive: n = 0 but the chain has 5; differential_drive: joint index 1 outside 0…-1; "
+        "differential_drive: joint index 2 outside 0…-1; differential_drive: joint index 0 outside 0…-1");
 }
 
 TEST_CASE("bad input: a user constraint whose functions return the wrong shapes is an input_error") {

@@ -206,6 +206,73 @@ TEST_CASE("inverse_dynamics, run-time sized: the stack-scratch call is project �
   }
 }
 
+TEST_CASE("run-time-sized chain: evaluate of inverse_dynamics and inverse_dynamics_with_forces (with and "
+          "without friction) = the stages composed by hand; lambda makes v = E tau + A^T lambda") {
+  // The evaluate forms (constraints/stages.hpp, staged_inverse_dynamics) write ξ into stack
+  // scratch (a thread's heap block beyond 256 joints) and v over q̈ (the chain's rne, v on q̈'s
+  // storage): τ equals the hand-composed stages' bit for bit, the fused call's too.
+  const auto p5 = nhdyn::presets::paper5_chain<double>();
+  std::vector<nhdyn::link<double>> links;
+  for (int i = 0; i < 300; ++i) links.push_back(p5[i < 3 ? i : 3 + (i % 2)]);
+  const nhdyn::chain<double> long_chain(links, p5.gravity(), "paper5 base, 297-joint arm");
+  rng R;
+  nhdyn::constrained_forces<double> out;  // reused across the chains: sizes change
+  for (const auto& ch : {p5.dynamic_size(), long_chain}) {
+    const int n = ch.dof();
+    INFO(ch.name());
+    const nhdyn::differential_drive<double> c(n, 0, 1, 2, 0.0, -1.0);
+    std::vector<nhdyn::joint_friction> laws;
+    for (int j = 0; j < n; ++j) laws.push_back({0.3 + 0.001 * j, 0.2, -0.15});
+    const nhdyn::friction_fn fr(laws, nhdyn::coulomb_law::smooth(0.05));
+    Vec tau = Vec::Constant(n - 1, 7.0);  // evaluate does not resize: a wrong size is an error (below)
+    const auto check = [&](const auto& id, const auto& idf, const auto& by_hand, const auto& by_hand_f, const auto& dyn) {
+      for (int k = 0; k < 3; ++k) {
+        const Vec q = R.vec(n, 3.0), eta = R.vec(n - 1, 2.0), etad = R.vec(n - 1, 2.0);
+        id.evaluate(q, eta, etad, tau);
+        const Vec want = by_hand(q, eta, etad);
+        REQUIRE(tau == want);
+        REQUIRE(Vec(id(q, eta, etad)) == want);
+        idf.evaluate(q, eta, etad, out);
+        const auto call = idf(q, eta, etad);
+        REQUIRE(out.tau == want);
+        REQUIRE(Vec(call.tau) == want);
+        REQUIRE(Vec(call.lambda) == out.lambda);
+        const auto hand = by_hand_f(q, eta, etad);
+        REQUIRE(hand.lambda.size() == 1);
+        CHECK((out.lambda - Vec(hand.lambda)).cwiseAbs().maxCoeff() <= 1e-10 * (1 + out.lambda.cwiseAbs().maxCoeff()));
+        // v = E τ + Aᵀ λ (E = S here): v the stationary chain's dynamics at the lifted state
+        const Vec qd = c.S(q) * eta, qdd = c.S(q) * etad + c.Sdot(q, qd) * eta;
+        const Vec v = dyn(q, qd, qdd);
+        const Vec recon = c.S(q) * out.tau + c.A(q).transpose() * out.lambda;
+        CHECK((recon - v).cwiseAbs().maxCoeff() <= 1e-9 * (1 + v.cwiseAbs().maxCoeff()));
+      }
+    };
+    check(nhdyn::inverse_dynamics(ch, c), nhdyn::inverse_dynamics_with_forces(ch, c),
+          nhdyn::lift(c) | nhdyn::rne(ch) | nhdyn::project(c), nhdyn::lift(c) | nhdyn::rne(ch) | nhdyn::constraint_forces(c),
+          [&](const Vec& q, const Vec& qd, const Vec& qdd) { return Vec(nhdyn::rne(ch)(q, qd, qdd)); });
+    check(nhdyn::inverse_dynamics(ch, c, {}, fr), nhdyn::inverse_dynamics_with_forces(ch, c, {}, fr),
+          nhdyn::lift(c) | (nhdyn::rne(ch) + fr) | nhdyn::project(c),
+          nhdyn::lift(c) | (nhdyn::rne(ch) + fr) | nhdyn::constraint_forces(c),
+          [&](const Vec& q, const Vec& qd, const Vec& qdd) { return Vec(nhdyn::rne(ch)(q, qd, qdd) + fr(qd)); });
+    // the chain's rne evaluate with v on q̈'s own storage = the call, bit for bit
+    const Vec q = R.vec(n), qd = R.vec(n), qdd = R.vec(n);
+    Vec v = qdd;
+    nhdyn::rne(ch).evaluate(q, qd, v, v);
+    REQUIRE(v == Vec(nhdyn::rne(ch)(q, qd, qdd)));
+    // … whose non-finite q̈ is overwrite_qdd's error (the other path's would name qdd[i])
+    v(1) = std::numeric_limits<double>::infinity();
+    CHECK_THROWS_WITH(nhdyn::rne(ch).evaluate(q, qd, v, v), Catch::Contains("or the computation overflowed"));
+    // errors name the argument
+    const Vec eta = R.vec(n - 1);
+    Vec bad = eta;
+    bad(n - 2) = std::numeric_limits<double>::quiet_NaN();
+    CHECK_THROWS_WITH(nhdyn::inverse_dynamics(ch, c).evaluate(q, eta, bad, tau), Catch::Contains("eta_dot"));
+    CHECK_THROWS_WITH(nhdyn::inverse_dynamics_with_forces(ch, c).evaluate(q, bad, eta, out), Catch::Contains("eta["));
+    Vec short_tau(n - 2);
+    CHECK_THROWS_WITH(nhdyn::inverse_dynamics(ch, c).evaluate(q, eta, eta, short_tau), Catch::Contains("tau"));
+  }
+}
+
 TEST_CASE("inverse_dynamics, compile-time sized: the stack-scratch call is project ∘ rne ∘ lift, bit for bit") {
   // Compile-time sized, (q, η, η̇) with a floating-point state also runs on stack scratch
   // (q̇, q̈, v never move between stages); the stages composed by hand pass fixed-size values

@@ -34,7 +34,7 @@ const std::string usage = std::string(R"(nhdyn id --model MODEL [--strict] [--lo
 /// Lines of a model with a constraint: (q, η, η̇) -> (τ, λ); `dyn` is rne or rne + friction.
 template <class Model, class C, class Dyn>
 int constrained(const Model& model, const C& c, const std::string& name, const nhdyn::terms& t, const Dyn& dyn) {
-  // project ∘ rne ∘ lift (its fused path on a chain), or with friction in rne's place
+  // constraint_forces ∘ rne ∘ lift, or with friction in rne's place
   const auto id = [&] {
     if constexpr (std::is_same_v<Dyn, decltype(nhdyn::rne(model))>)
       return nhdyn::inverse_dynamics_with_forces(model, c, t.rne());

@@ -42,17 +42,17 @@ struct differential_drive {
   }
 
   void validate() const {
-    std::ostringstream os;
-    if (N != dynamic && n != N) os << "differential_drive: n = " << n << " but the chain has " << N;
+    std::ostringstream os;  // every flaw, each ending "; "
+    if (N != dynamic && n != N) os << "differential_drive: n = " << n << " but the chain has " << N << "; ";
     for (int j : {x, y, heading})
-      if (j < 0 || j >= n) os << "differential_drive: joint index " << j << " outside 0…" << n - 1;
+      if (j < 0 || j >= n) os << "differential_drive: joint index " << j << " outside 0…" << n - 1 << "; ";
     if (x == y || x == heading || y == heading)
       os << "differential_drive: x, y and heading joints must differ (" << x << ", " << y << ", "
-         << heading << ")";
+         << heading << "); ";
     const double s = value_of(heading_sign);
-    if (s != 1.0 && s != -1.0) os << "differential_drive: heading_sign must be +1 or −1, not " << s;
-    if (!is_finite_scalar(forward_offset)) os << "differential_drive: forward_offset is not finite";
-    if (!os.str().empty()) throw model_error(os.str());
+    if (s != 1.0 && s != -1.0) os << "differential_drive: heading_sign must be +1 or −1, not " << s << "; ";
+    if (!is_finite_scalar(forward_offset)) os << "differential_drive: forward_offset is not finite; ";
+    if (!os.str().empty()) throw model_error(os.str().substr(0, os.str().size() - 2));
   }
 
   int dof() const { return n; }

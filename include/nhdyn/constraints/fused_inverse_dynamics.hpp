@@ -1,8 +1,10 @@
 #pragma once
 /// \file constraints/fused_inverse_dynamics.hpp
 /// The one fused path of the nonholonomic inverse dynamics, and `inverse_dynamics(chain, c)`,
-/// which uses it. Everything else (the tree form, `inverse_dynamics_with_forces`, user
-/// pipelines) is the plain composition project ∘ rne ∘ lift of constraints/stages.hpp.
+/// which uses it for its call (its `evaluate`, on a run-time-sized chain, is the stages'
+/// detail::staged_inverse_dynamics). Everything else (the tree form,
+/// `inverse_dynamics_with_forces`, user pipelines) is the composition project ∘ rne ∘ lift of
+/// constraints/stages.hpp (where run-time sized, with its `evaluate` into storage).
 ///
 /// What it buys (nhdyn_bench `nh_fused/<model>/{fixed, run_time}`, paired, ratio = fused /
 /// composition; g++ 12.2.0 -O3 -march=native, 2026-11-25): paper5 0.82 (fixed) and 0.74
@@ -161,8 +163,8 @@ struct scratch_inverse_dynamics : Composed {
 template <class S, int N, pfaffian_constraint C>
 auto inverse_dynamics(const chain<S, N>& ch, const C& c, rne_options o = {}) {
   auto id = detail::nh_pipeline(ch, c, o, project(c));
-  if constexpr (N == C::n_at_compile_time)
-    return detail::scratch_inverse_dynamics<decltype(id), S, C>(std::move(id));
+  if constexpr (N == C::n_at_compile_time)  // the call fused; run-time sized, evaluate too
+    return detail::with_evaluate<S, N, C, false>(detail::scratch_inverse_dynamics<decltype(id), S, C>(std::move(id)));
   else
     return id;
 }

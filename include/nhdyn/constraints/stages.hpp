@@ -370,12 +370,6 @@ auto nh_pipeline(const chain<S, N>& ch, const C& c, rne_options o, Out out) {
 }  // namespace detail
 
 
-/// As inverse_dynamics, returning (τ, λ).
-template <class S, int N, pfaffian_constraint C>
-auto inverse_dynamics_with_forces(const chain<S, N>& ch, const C& c, rne_options o = {}) {
-  return detail::nh_pipeline(ch, c, o, constraint_forces(c));
-}
-
 namespace detail {
 /// out ∘ dyn ∘ lift on a tree (run-time sized; a compile-time-sized constraint's ξ resized);
 /// dyn is rne(t, o) or a stage in its place.
@@ -395,25 +389,28 @@ auto nh_tree_pipeline(const tree<S>& t, const C& c, rne_options o, Out out) {
   return nh_pipeline_with(t, c, rne(t, o), std::move(out));
 }
 
-/// inverse_dynamics on a tree (constraint run-time sized): the composition project ∘ rne ∘
-/// lift itself (it derives from it: every call form it has, the same numbers), and
-/// `evaluate(q, η, η̇, τ)`, the same three stages into storage: lift.into writes ξ's q̇ and q̈
-/// into stack scratch (beyond 256 joints, a heap block the thread keeps), rne.evaluate writes
-/// v over q̈, project.into writes τ into the caller's vector. No allocation where the constraint lifts and projects
-/// into given storage (every built-in base constraint; wheeled_base with k·|η ∩ W| ≤ 24).
+/// inverse_dynamics on a tree or a run-time-sized chain (the constraint run-time sized too):
+/// the composition project ∘ rne ∘ lift itself (it derives from it: every call form it has,
+/// the same numbers), and `evaluate(q, η, η̇, τ)`, the same three stages into storage:
+/// lift.into writes ξ's q̇ and q̈ into stack scratch (beyond 256 joints, a heap block the
+/// thread keeps), rne.evaluate writes v over q̈, project.into writes τ into the caller's
+/// vector. No allocation where the constraint lifts and projects into given storage (every
+/// built-in base constraint; wheeled_base with k·|η ∩ W| ≤ 24).
 /// inverse_dynamics_with_forces takes the same form, its last stage constraint_forces:
 /// `evaluate(q, η, η̇, out)` writes τ and λ into a constrained_forces (its into).
-template <class Composed, class C>
-struct tree_inverse_dynamics : Composed {
-  explicit tree_inverse_dynamics(Composed c) : Composed(std::move(c)) {}
+/// Call: whether the call (q, η, η̇) runs evaluate into a new τ; a chain's inverse_dynamics
+/// keeps its fused call (constraints/fused_inverse_dynamics.hpp) and gains evaluate only.
+template <class Composed, class C, bool Call = true>
+struct staged_inverse_dynamics : Composed {
+  explicit staged_inverse_dynamics(Composed c) : Composed(std::move(c)) {}
 
   /// The call: with (q, η, η̇) as vectors whose promoted scalar is τ's, evaluate into a new τ
   /// (its one allocation: the three stages' intermediates stay in evaluate's scratch); any other
-  /// call form (a reduced_state, a tree of another scalar than the constraint's), the
-  /// composition's.
+  /// call form (a reduced_state, a model of another scalar than the constraint's), or Call
+  /// false, the composition's.
   template <class... X>
   decltype(auto) operator()(X&&... x) const {
-    if constexpr (call_evaluates<X...>()) {
+    if constexpr (Call && call_evaluates<X...>()) {
       using R = std::decay_t<decltype(Composed::operator()(std::forward<X>(x)...))>;
       R out;
       if constexpr (std::is_base_of_v<Eigen::MatrixBase<R>, R>) out.resize(actuator_count(this->f.constraint()));
@@ -480,46 +477,52 @@ struct tree_inverse_dynamics : Composed {
     projection.into(q, v, memo, out);
   }
 };
-}  // namespace detail
 
-/// The nonholonomic inverse dynamics of a tree: project ∘ rne ∘ lift, the constraint over the
-/// tree's joints in q order. With a run-time-sized constraint that lifts into given storage,
-/// it also evaluates into a τ the caller reuses (`evaluate(q, eta, eta_dot, tau)`).
-namespace detail {
-/// The composition id, as tree_inverse_dynamics (with evaluate) where the constraint is run-time
-/// sized and lifts into given storage.
-template <class S, class C, class Id>
-auto with_tree_evaluate(Id id) {
+/// The composition id, as staged_inverse_dynamics (with evaluate) where the model (a tree, or
+/// a chain of N joints) and the constraint are run-time sized and the constraint lifts into given
+/// storage (a fixed-size chain's stages allocate nothing already).
+template <class S, int N, class C, bool Call = true, class Id>
+auto with_evaluate(Id id) {
   constexpr bool lifts_into = requires(const C& k, const vecN<S, dynamic>& x, Eigen::Map<vecN<S, dynamic>>& m) {
     k.lift_into(x, x, x, m, m);
   };
-  if constexpr (C::n_at_compile_time == dynamic && lifts_into)
-    return tree_inverse_dynamics<Id, C>(std::move(id));
+  if constexpr (N == dynamic && C::n_at_compile_time == dynamic && lifts_into)
+    return staged_inverse_dynamics<Id, C, Call>(std::move(id));
   else
     return id;
 }
 }  // namespace detail
+
+/// As inverse_dynamics on a chain (constraints/fused_inverse_dynamics.hpp), returning (τ, λ):
+/// with evaluate where the chain and the constraint are run-time sized.
+template <class S, int N, pfaffian_constraint C>
+auto inverse_dynamics_with_forces(const chain<S, N>& ch, const C& c, rne_options o = {}) {
+  return detail::with_evaluate<S, N, C>(detail::nh_pipeline(ch, c, o, constraint_forces(c)));
+}
+
+/// The nonholonomic inverse dynamics of a tree: project ∘ rne ∘ lift, the constraint over the
+/// tree's joints in q order. With a run-time-sized constraint that lifts into given storage,
+/// it also evaluates into a τ the caller reuses (`evaluate(q, eta, eta_dot, tau)`).
 template <class S, pfaffian_constraint C>
 auto inverse_dynamics(const tree<S>& t, const C& c, rne_options o = {}) {
-  return detail::with_tree_evaluate<S, C>(detail::nh_tree_pipeline(t, c, o, project(c)));
+  return detail::with_evaluate<S, dynamic, C>(detail::nh_tree_pipeline(t, c, o, project(c)));
 }
 /// As inverse_dynamics on a tree, returning (τ, λ).
 template <class S, pfaffian_constraint C>
 auto inverse_dynamics_with_forces(const tree<S>& t, const C& c, rne_options o = {}) {
-  return detail::with_tree_evaluate<S, C>(detail::nh_tree_pipeline(t, c, o, constraint_forces(c)));
+  return detail::with_evaluate<S, dynamic, C>(detail::nh_tree_pipeline(t, c, o, constraint_forces(c)));
 }
 
 /// With the joints' friction τ_f(q̇) (dynamics/friction.hpp, dynamics/terms.hpp):
-/// project ∘ (rne + friction) ∘ lift, on a chain or a tree (on a tree with `evaluate`, as without).
+/// project ∘ (rne + friction) ∘ lift, on a chain or a tree (with `evaluate` where the model and
+/// the constraint are run-time sized, as without friction).
 template <class Model, pfaffian_constraint C>
   requires(std::is_same_v<Model, tree<typename Model::scalar_type>> ||
            std::is_same_v<Model, chain<typename Model::scalar_type, Model::size_at_compile_time>>)
 auto inverse_dynamics(const Model& m, const C& c, rne_options o, friction_fn f) {
   using S = typename Model::scalar_type;
-  if constexpr (std::is_same_v<Model, tree<S>>)  // with evaluate, as without friction
-    return detail::with_tree_evaluate<S, C>(detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), project(c)));
-  else
-    return detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), project(c));
+  return detail::with_evaluate<S, Model::size_at_compile_time, C>(
+      detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), project(c)));
 }
 /// As inverse_dynamics with friction, returning (τ, λ).
 template <class Model, pfaffian_constraint C>
@@ -527,10 +530,8 @@ template <class Model, pfaffian_constraint C>
            std::is_same_v<Model, chain<typename Model::scalar_type, Model::size_at_compile_time>>)
 auto inverse_dynamics_with_forces(const Model& m, const C& c, rne_options o, friction_fn f) {
   using S = typename Model::scalar_type;
-  if constexpr (std::is_same_v<Model, tree<S>>)  // with evaluate, as without friction
-    return detail::with_tree_evaluate<S, C>(detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), constraint_forces(c)));
-  else
-    return detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), constraint_forces(c));
+  return detail::with_evaluate<S, Model::size_at_compile_time, C>(
+      detail::nh_pipeline_with(m, c, rne(m, o) + std::move(f), constraint_forces(c)));
 }
 
 }  // namespace nhdyn

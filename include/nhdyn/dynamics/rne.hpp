@@ -275,14 +275,24 @@ class rne_fn : public stage_tag {
   }
 
   /// v = rne(q, q̇, q̈) into v (n entries, of the model's and the inputs' promoted scalar; a
-  /// vector or a map: no allocation): the call's numbers and checks. v must not alias the
-  /// inputs (overwrite_qdd writes v over q̈).
+  /// vector or a map: no allocation): the call's numbers and checks. v may be q̈'s own storage
+  /// (the same start, size and stride: then it runs as overwrite_qdd, whose error on a
+  /// non-finite q̈ is overwrite_qdd's numerical_error, not an input_error naming q̈); it must
+  /// not alias q or q̇.
   template <class Q, class QD, class QDD, class V>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
                 Eigen::MatrixBase<V>& v) const {
     static_assert(std::is_same_v<typename V::Scalar, promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename QD::Scalar>,
                                                               typename QDD::Scalar>>,
                   "v's scalar is the model's and the inputs' promoted scalar");
+    if constexpr ((int(QDD::Flags) & int(V::Flags) & Eigen::DirectAccessBit) != 0) {
+      if (static_cast<const void*>(qdd.derived().data()) == static_cast<const void*>(v.derived().data()) &&
+          qdd.size() == v.size() && qdd.derived().innerStride() == v.derived().innerStride()) {
+        detail::check_size(v, n_, "v");
+        run_checked(q.derived(), qd.derived(), v.derived(), v.derived());
+        return;
+      }
+    }
     detail::check_size(q, n_, "q");
     detail::check_size(qd, n_, "qd");
     detail::check_size(qdd, n_, "qdd");
