@@ -89,8 +89,10 @@ inline tree<double> with_length_factors(const tree<double>& t, const std::vector
 }
 
 /// The robot a scene names (not paper5, which `simulate` runs): a preset, a URDF, a robot file
-/// or a JSON model, as a tree with its optional constraint.
-inline io::robot_model load_scene_robot(const std::string& robot) {
+/// or a JSON model, as a tree with its optional constraint. (In nhdyn::compiled.)
+NHDYN_COMPILED_INLINE io::robot_model load_scene_robot(const std::string& robot);
+#if NHDYN_DEFINES(NHDYN_PART_SIMULATION)
+NHDYN_COMPILED_INLINE io::robot_model load_scene_robot(const std::string& robot) {
   const auto presets = io::preset_names();
   std::string ext = std::filesystem::path(robot).extension().string();
   for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
@@ -109,6 +111,7 @@ inline io::robot_model load_scene_robot(const std::string& robot) {
   r.path = robot;
   return r;
 }
+#endif
 
 namespace detail {
 /// A scene's robot set up as trees (see the file comment): plant and nominal model, the
@@ -126,7 +129,12 @@ struct scene_setup {
   std::vector<std::string> eta_names;
 };
 
-inline scene_setup setup_scene(const run_spec& s) {
+/// The set-up of scene s (throws for one that cannot be set up). In nhdyn::compiled: its body
+/// instantiates every constraint type's construction (wheeled_base's SVD among them), 7.7 s of
+/// g++'s time at -O1 in each file that includes this header.
+NHDYN_COMPILED_INLINE scene_setup setup_scene(const run_spec& s);
+#if NHDYN_DEFINES(NHDYN_PART_SIMULATION)
+NHDYN_COMPILED_INLINE scene_setup setup_scene(const run_spec& s) {
   const std::string where = "scene '" + s.name + "': ";
   scene_setup out;
   // the trees as their terms want them (after everything else read them: the constraints, frames)
@@ -204,6 +212,7 @@ inline scene_setup setup_scene(const run_spec& s) {
   out.c_model = constraint_of(out.nominal, s.model_wheel_radius, "model");
   return apply_terms(out);
 }
+#endif
 }  // namespace detail
 
 /// One run of a scene on its robot as a tree (paper5 included) with the controller
