@@ -367,10 +367,6 @@ auto nh_pipeline(const chain<S, N>& ch, const C& c, rne_options o, Out out) {
   return nh_pipeline_with(ch, c, rne(ch, o), std::move(out));
 }
 
-}  // namespace detail
-
-
-namespace detail {
 /// out ∘ dyn ∘ lift on a tree (run-time sized; a compile-time-sized constraint's ξ resized);
 /// dyn is rne(t, o) or a stage in its place.
 template <class S, class C, class Dyn, class Out>
