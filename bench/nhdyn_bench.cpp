@@ -25,6 +25,8 @@
 ///                                                wheels robot as a wheeled_base too) vs
 ///                                                projected E–L on the tree, paired
 ///                                               with the holonomic rne, and its forward dynamics
+///   el_pair/<robot>                             the method's call and projected E–L paired
+///                                               (counter `ratio` = E–L / nh)
 /// Every case checks its answer once, untimed, against an independent computation (KDL, the
 /// Lagrangian, the run-time-sized variant) and aborts on disagreement; every case reports
 /// `allocs_per_call`, the heap allocations of one call (counted by alloc_counter.cpp).
@@ -756,6 +758,20 @@ void register_wheeled(const std::string& model, const nhdyn::tree<double>& t, co
       [id, q, eta, eta_dot]() mutable {
         opaque(q), opaque(eta), opaque(eta_dot);
         auto r = id(q, eta, eta_dot);
+        benchmark::DoNotOptimize(r);
+      });
+  // E–L / nh itself, paired (a = the method's call, b = the projected Euler–Lagrange
+  // equations): both sides see the same machine state, as nh / holonomic does
+  add_paired(
+      "el_pair/" + model,
+      [id, q, eta, eta_dot]() mutable {
+        opaque(q), opaque(eta), opaque(eta_dot);
+        auto r = id(q, eta, eta_dot);
+        benchmark::DoNotOptimize(r);
+      },
+      [el, q, eta, eta_dot]() mutable {
+        opaque(q), opaque(eta), opaque(eta_dot);
+        auto r = el(q, eta, eta_dot);
         benchmark::DoNotOptimize(r);
       });
   if constexpr (has_evaluate) {
