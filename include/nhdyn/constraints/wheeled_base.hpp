@@ -518,6 +518,18 @@ class wheeled_base {
     }
     ~memo() { release(); }
     const T* data() const { return size <= inline_capacity ? small.data() : large.data(); }
+    /// n entries for the caller to write (default-constructed).
+    T* reset(int n) {
+      release();
+      if (n <= inline_capacity) {
+        size = n;
+        return small.data();
+      }
+      large = detail::scratch_blocks<T>::take(static_cast<std::size_t>(n));
+      std::uninitialized_value_construct_n(large.data(), n);
+      size = n;
+      return large.data();
+    }
     void assign(const T* from, int n) {
       release();
       if (n <= inline_capacity) {
@@ -551,27 +563,38 @@ class wheeled_base {
                     Eigen::MatrixBase<QDo>& qd, Eigen::MatrixBase<QDDo>& qdd) const {
     check_q(q);
     detail::check_size(eta_dot, m(), "eta_dot");
-    const factored<T> f(*this, q, true);
-    velocities(f.sd.data(), eta, qd);
-    // −A_D⁻¹ Ȧ q̇ (in D's order), then q̈: η̇ at η's joints, S_D η̇ − A_D⁻¹ Ȧ q̇ at D's
+    // −A_D⁻¹ Ȧ q̇ (in D's order) into x, S_D into the memo
     const int kk = k();
     detail::wheel_buffer<T, dynamic> b(kk), x(kk);
-    if (f.body)
-      body_Adot_qdot(f.yaw, f.ub.data(), qd, b.data());
-    else
-      Adot_qdot(f.X.data(), qd, b.data());
-    f.solve(b.data(), x.data());
+    memo<T> out;
+    if (body_rigid_kernel<T>()) {  // no wheel steered: S_D and A_D⁻¹ are turns of constants
+      const vec2<T> cs = turn_of<T>(body_yaw_, q);
+      T* const sd = out.reset(kk * mw());
+      body_rigid_sd(cs, sd);
+      velocities(sd, eta, qd);
+      if constexpr (body_kernel_for<T>) body_Adot_qdot(cs, body_u0_.data(), qd, b.data());
+      body_rigid_solve(cs, b.data(), x.data());
+    } else {
+      const factored<T> f(*this, q, true);
+      out.assign(f.sd.data(), kk * mw());
+      velocities(f.sd.data(), eta, qd);
+      if (f.body)
+        body_Adot_qdot(f.yaw, f.ub.data(), qd, b.data());
+      else
+        Adot_qdot(f.X.data(), qd, b.data());
+      f.solve(b.data(), x.data());
+    }
+    // q̈: η̇ at η's joints, S_D η̇ − A_D⁻¹ Ȧ q̇ at D's
+    const T* const sd = out.data();
     const int mm = m(), mwi = mw();
     for (int c = 0; c < mm; ++c) qdd(eta_[std::size_t(c)]) = T(eta_dot(c));
     for (int d = 0; d < kk; ++d) {
       T a = -x[d];
-      for (int i = 0; i < mwi; ++i) a += f.sd[d + i * kk] * T(eta_dot(Icol_[std::size_t(i)]));
+      for (int i = 0; i < mwi; ++i) a += sd[d + i * kk] * T(eta_dot(Icol_[std::size_t(i)]));
       qdd(Dq_[std::size_t(d)]) = a;
       if (!is_finite_scalar(a)) [[unlikely]]
         throw_not_solved(d, "accelerations");
     }
-    memo<T> out;
-    out.assign(f.sd.data(), kk * mw());
     return out;
   }
   /// τ from (q, v) with the lift's S_D at that q: the projection (SᵀE)⁺_W Sᵀ v without forming A
@@ -1134,11 +1157,28 @@ class wheeled_base {
     }
     body_rigid_ = true;
   }
+  /// Whether the lift and the projection in T take prepare_body_rigid's constants.
+  template <class T>
+  bool body_rigid_kernel() const {
+    return body_kernel<T>() && body_rigid_;
+  }
+  /// x = A_D⁻¹ b = T_D⁻¹ A_D0⁻¹ b at (cos ψ, sin ψ) = cs (prepare_body_rigid; b: k entries in
+  /// A's row order, x: k in D's order).
+  template <class T>
+  void body_rigid_solve(const vec2<T>& cs, const T* b, T* x) const {
+    const int k = this->k();
+    const Sc* const adinv = body_adinv_.data();
+    for (int d = 0; d < k; ++d) x[d] = T(0);
+    for (int r = 0; r < k; ++r)
+      for (int d = 0; d < k; ++d) x[d] += T(adinv[d + r * k]) * b[r];
+    if (const int d1 = body_dpair_[0]; d1 >= 0) body_pair_turn(cs, x[d1], x[body_dpair_[1]]);
+  }
   /// S_D = T_D⁻¹ S_D0 T_I at (cos ψ, sin ψ) = cs (prepare_body_rigid), into sd (k × |η ∩ W|).
   template <class T>
   void body_rigid_sd(const vec2<T>& cs, T* sd) const {
     const int kk = k(), mwi = mw();
-    for (int i = 0; i < kk * mwi; ++i) sd[i] = T(body_sd0_[std::size_t(i)]);
+    const Sc* const sd0 = body_sd0_.data();
+    for (int i = 0; i < kk * mwi; ++i) sd[i] = T(sd0[i]);
     if (const int i1 = body_ipair_[0]; i1 >= 0)  // a row s times T_I: (T_Iᵀ sᵀ)ᵀ, T_Iᵀ = Paᵀ R(ψ) Pa
       for (int d = 0; d < kk; ++d) body_pair_turn(cs, sd[d + i1 * kk], sd[d + body_ipair_[1] * kk]);
     if (const int d1 = body_dpair_[0]; d1 >= 0)
@@ -1220,14 +1260,7 @@ class wheeled_base {
     /// x = A_D⁻¹ b (b: k entries in A's row order; x: k entries in D's order). A planar base's
     /// three dependent velocities (x, y, ψ) at a compile-time size, any other count at run time.
     void solve(const T* b, T* x) const {
-      if (rigid) {  // T_D⁻¹ A_D0⁻¹ b
-        const int k = c.k();
-        for (int d = 0; d < k; ++d) x[d] = T(0);
-        for (int r = 0; r < k; ++r)
-          for (int d = 0; d < k; ++d) x[d] += T(c.body_adinv_[std::size_t(d + r * k)]) * b[r];
-        if (const int d1 = c.body_dpair_[0]; d1 >= 0) c.body_pair_turn(yaw, x[d1], x[c.body_dpair_[1]]);
-        return;
-      }
+      if (rigid) return c.body_rigid_solve(yaw, b, x);
       if (c.kb_ == 3)
         solve_n<3>(b, x);
       else
@@ -1319,7 +1352,7 @@ class wheeled_base {
     for (const auto& [a, c] : act_eta_)
       for (Eigen::Index j = 0; j < cols; ++j) tau(a, j) = U(r(c, j));
     if constexpr (std::is_same_v<typename Q::Scalar, T>)  // (a q of another scalar: the general path)
-      if (body_kernel<T>() && body_rigid_) return body_rigid_actuation_into<U>(turn_of<T>(body_yaw_, q), r, tau);
+      if (body_rigid_kernel<T>()) return body_rigid_actuation_into<U>(turn_of<T>(body_yaw_, q), r, tau);
     switch (mw()) {
       case 0:  // the wheels allow no motion: their actuators need no torque
         for (const auto& aw : actw_) tau.row(aw.first).setZero();
@@ -1336,13 +1369,14 @@ class wheeled_base {
   void body_rigid_actuation_into(const vec2<T>& cs, const R& r, Out& tau) const {
     const int mwi = mw(), pwi = pw();
     const vec2<U> back(U(cs.x()), U(-cs.y()));  // R(−ψ)
+    const Sc* const act0 = body_act0_.data();
     detail::wheel_buffer<U, dynamic> x(mwi);
     for (Eigen::Index j = 0; j < r.cols(); ++j) {
       for (int i = 0; i < mwi; ++i) x[i] = U(r(Icol_[std::size_t(i)], j));
       if (const int i1 = body_ipair_[0]; i1 >= 0) body_pair_turn(back, x[i1], x[body_ipair_[1]]);
       for (int a = 0; a < pwi; ++a) {
         U t(0);
-        for (int i = 0; i < mwi; ++i) t += U(body_act0_[std::size_t(a + i * pwi)]) * x[i];
+        for (int i = 0; i < mwi; ++i) t += U(act0[a + i * pwi]) * x[i];
         tau(actw_[std::size_t(a)].first, j) = t;
       }
     }
