@@ -28,7 +28,7 @@
 ///   el_pair/<robot>                             the method's call and projected E–L paired
 ///                                               (counter `ratio` = E–L / nh)
 /// Every case checks its answer once, untimed, against an independent computation (KDL, the
-/// Lagrangian, the run-time-sized variant) and aborts on disagreement; every case reports
+/// Lagrangian, the run-time-sized variant) and aborts on disagreement; every unpaired case reports
 /// `allocs_per_call`, the heap allocations of one call (counted by alloc_counter.cpp).
 #include <benchmark/benchmark.h>
 

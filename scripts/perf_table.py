@@ -67,7 +67,7 @@ PAIRED = {}  # nh_pair/<model>/<size> → median over repetitions of time(nh) / 
 def load(path):
     with open(path) as f:
         data = json.load(f)
-    med, allocs, reps = {}, {}, {}
+    med, allocs, reps, paired = {}, {}, {}, {}
     for b in data["benchmarks"]:
         name = b.get("run_name", b["name"])
         if b.get("aggregate_name") == "median":
@@ -76,11 +76,12 @@ def load(path):
             if "allocs_per_call" in b:
                 allocs[name] = b["allocs_per_call"]
             if "ratio" in b:  # a paired measurement (nh_pair/…): the median of its ratio counter
-                PAIRED[name] = b["ratio"]
+                paired.setdefault(name, []).append(b["ratio"])
             reps[name] = b.get("repetitions", 1)
     if not med:
         sys.exit("perf_table.py: no median aggregates in %s (run with --benchmark_repetitions)" % path)
     med = {name: statistics.median(v) for name, v in med.items()}  # over the sittings' medians
+    PAIRED.update({name: statistics.median(v) for name, v in paired.items()})  # the same for the paired ratios
     return data["context"], med, allocs, reps
 
 
@@ -304,8 +305,12 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
     out.append("")
 
     # ---------------------------------------------------------------- wheeled robots
-    def el_over_nh(m, el, nh):  # E–L / nh: paired (el_pair/<robot>) where the run has it, else the medians' ratio
+    def el_over_nh(m, el, nh):  # E–L / nh: paired (el_pair/<robot>); a run without it, the medians' ratio
         return PAIRED.get(f"el_pair/{m}", ratio(el, nh))
+
+    def el_cell(m, el, nh):  # the column: "—" without a figure, "(medians)" where not paired
+        x = el_over_nh(m, el, nh)
+        return "—" if x is None else f"{x:.1f}" + ("" if f"el_pair/{m}" in PAIRED else " (medians)")
 
     def nh_allocs(m):  # the wheeled tables' last column: (nh, nh evaluate, fd, fd evaluate)
         return ", ".join(al(allocs.get(f"{c}/{m}/{v}"))
@@ -330,7 +335,7 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
         worst_pair = max(worst_pair, pr or 0)
         worst_pair_ev = max(worst_pair_ev, pe or 0)
         least_el = min(least_el, el_over_nh(m, el, nh) or 0)
-        out.append(f"| {m} | {k} | {19 - k} | {ns(nh)} | {r2(pr)} | {ns(ev)} | {r2(pe)} | {ns(el)} | {el_over_nh(m, el, nh):.1f} | {ns(fd)} | {ns(g(f'nh_fd/{m}/evaluate'))} | "
+        out.append(f"| {m} | {k} | {19 - k} | {ns(nh)} | {r2(pr)} | {ns(ev)} | {r2(pe)} | {ns(el)} | {el_cell(m, el, nh)} | {ns(fd)} | {ns(g(f'nh_fd/{m}/evaluate'))} | "
                    f"{nh_allocs(m)} |")
     out.append("")
     out.append(f"- Target nh ≤ {TARGET_NH}× the holonomic rne (paired): worst **{worst_pair:.2f}** — "
@@ -359,7 +364,7 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
             worst_wp = max(worst_wp, pr or 0)
             worst_wpe = max(worst_wpe, pe or 0)
             least_wel = min(least_wel, el_over_nh(m, el, nh) or 0)
-        out.append(f"| {m} | {n_} | {k_} | {m_} | {p_} | {ns(nh)} | {r2(pr)} | {ns(ev)} | {r2(pe)} | {ns(el)} | {el_over_nh(m, el, nh):.1f} | {ns(fd)} | {ns(g(f'nh_fd/{m}/evaluate'))} | "
+        out.append(f"| {m} | {n_} | {k_} | {m_} | {p_} | {ns(nh)} | {r2(pr)} | {ns(ev)} | {r2(pe)} | {ns(el)} | {el_cell(m, el, nh)} | {ns(fd)} | {ns(g(f'nh_fd/{m}/evaluate'))} | "
                    f"{r2(PAIRED.get(f'deriv_nh_pair/{m}'))} | {nh_allocs(m)} |")
     out.append("")
     out.append(f"- Target nh ≤ {TARGET_WHEEL_NH}× the holonomic rne (paired, redundancy resolution included): worst "

@@ -518,7 +518,7 @@ class wheeled_base {
     }
     ~memo() { release(); }
     const T* data() const { return size <= inline_capacity ? small.data() : large.data(); }
-    /// n entries for the caller to write (default-constructed).
+    /// Room for n entries, which the caller writes (their values until then unspecified).
     T* reset(int n) {
       release();
       if (n <= inline_capacity) {
@@ -526,7 +526,7 @@ class wheeled_base {
         return small.data();
       }
       large = detail::scratch_blocks<T>::take(static_cast<std::size_t>(n));
-      std::uninitialized_value_construct_n(large.data(), n);
+      std::uninitialized_default_construct_n(large.data(), n);
       size = n;
       return large.data();
     }
@@ -567,14 +567,19 @@ class wheeled_base {
     const int kk = k();
     detail::wheel_buffer<T, dynamic> b(kk), x(kk);
     memo<T> out;
-    if (body_rigid_kernel<T>()) {  // no wheel steered: S_D and A_D⁻¹ are turns of constants
-      const vec2<T> cs = turn_of<T>(body_yaw_, q);
-      T* const sd = out.reset(kk * mw());
-      body_rigid_sd(cs, sd);
-      velocities(sd, eta, qd);
-      if constexpr (body_kernel_for<T>) body_Adot_qdot(cs, body_u0_.data(), qd, b.data());
-      body_rigid_solve(cs, b.data(), x.data());
-    } else {
+    bool rigid = false;
+    if constexpr (body_kernel_for<T>) {  // (the body kernel runs in the model's own scalar only)
+      rigid = body_rigid_kernel<T>();
+      if (rigid) {  // no wheel steered: S_D and A_D⁻¹ are turns of constants
+        const vec2<T> cs = turn_of<T>(body_yaw_, q);
+        T* const sd = out.reset(kk * mw());
+        body_rigid_sd(cs, sd);
+        velocities(sd, eta, qd);
+        body_Adot_qdot(cs, body_u0_.data(), qd, b.data());
+        body_rigid_solve(cs, b.data(), x.data());
+      }
+    }
+    if (!rigid) {
       const factored<T> f(*this, q, true);
       out.assign(f.sd.data(), kk * mw());
       velocities(f.sd.data(), eta, qd);
