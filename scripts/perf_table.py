@@ -61,7 +61,7 @@ BEYOND_DERIV_TARGETS = {"tree96"}
 TARGET_DERIV, TARGET_DERIV_NH, TARGET_DERIV_FD = 3.0, 3.5, 5.0
 BATCH_MODELS = ["paper5", "puma560", "mobile_manipulator", "tree12", "tree24", "tree48"]
 BATCH_STATES, TARGET_BATCH = 256, 2.5
-PAIRED = {}  # nh_pair/<model>/<size> → median over repetitions of time(nh) / time(rne)
+PAIRED = {}  # every paired case (nh_pair/…, el_pair/…, crba_pair/…) → the median over repetitions (and sittings) of its ratio counter
 
 
 def load(path):
