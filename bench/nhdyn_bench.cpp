@@ -721,16 +721,19 @@ void register_wheeled(const std::string& model, const nhdyn::tree<double>& t, co
   projected_lagrange<C, tree_lagrange_terms> el(t, c);
   const Eigen::VectorXd tau = id(q, eta, eta_dot);
   agree(tau, el(q, eta, eta_dot), 1e-10, "nh_id/" + model + ": rne vs projected Lagrange");
-  add("nh_id/" + model + "/rne", [id, q, eta, eta_dot]() mutable {
+  // the method's call and E–L's, timed alone (nh_id) and paired (nh_pair, el_pair)
+  const auto nh_call = [id, q, eta, eta_dot]() mutable {
     opaque(q), opaque(eta), opaque(eta_dot);
     auto r = id(q, eta, eta_dot);
     benchmark::DoNotOptimize(r);
-  });
-  add("nh_id/" + model + "/lagrange", [el, q, eta, eta_dot]() mutable {
+  };
+  const auto el_call = [el, q, eta, eta_dot]() mutable {
     opaque(q), opaque(eta), opaque(eta_dot);
     auto r = el(q, eta, eta_dot);
     benchmark::DoNotOptimize(r);
-  });
+  };
+  add("nh_id/" + model + "/rne", nh_call);
+  add("nh_id/" + model + "/lagrange", el_call);
   // the method into a τ the caller reuses (inverse_dynamics on a tree: every built-in constraint)
   constexpr bool has_evaluate = requires(Eigen::VectorXd& out) { id.evaluate(q, eta, eta_dot, out); };
   if constexpr (has_evaluate) {
@@ -755,25 +758,9 @@ void register_wheeled(const std::string& model, const nhdyn::tree<double>& t, co
         auto v = rn(xq, xqd, xqdd);
         benchmark::DoNotOptimize(v);
       },
-      [id, q, eta, eta_dot]() mutable {
-        opaque(q), opaque(eta), opaque(eta_dot);
-        auto r = id(q, eta, eta_dot);
-        benchmark::DoNotOptimize(r);
-      });
-  // E–L / nh itself, paired (a = the method's call, b = the projected Euler–Lagrange
-  // equations): both sides see the same machine state, as nh / holonomic does
-  add_paired(
-      "el_pair/" + model,
-      [id, q, eta, eta_dot]() mutable {
-        opaque(q), opaque(eta), opaque(eta_dot);
-        auto r = id(q, eta, eta_dot);
-        benchmark::DoNotOptimize(r);
-      },
-      [el, q, eta, eta_dot]() mutable {
-        opaque(q), opaque(eta), opaque(eta_dot);
-        auto r = el(q, eta, eta_dot);
-        benchmark::DoNotOptimize(r);
-      });
+      nh_call);
+  // E–L / nh itself, paired: both sides see the same machine state, as nh / holonomic does
+  add_paired("el_pair/" + model, nh_call, el_call);
   if constexpr (has_evaluate) {
     // the same pair with both sides into storage the caller reuses (no allocator in either)
     add_paired(
