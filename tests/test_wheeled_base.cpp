@@ -11,6 +11,7 @@
 /// - paper5.json (URDF + robot file) = the paper5 preset to 1e-12;
 /// - a user constraint coupling a wheel and an arm joint on the tree.
 #include <catch2/catch.hpp>
+#include <numbers>
 
 #include <nhdyn/io/robot_file.hpp>
 #include <nhdyn/kinematics/tree.hpp>
@@ -268,7 +269,13 @@ TEST_CASE("wheeled robots: an unforced 10 s motion keeps A q_dot = 0 and the ene
             eta(0) = 10.0;  // wheel rates [rad/s]: about 1 m/s, turning
             eta(1) = 8.0;
           } else {
-            eta(0) = 1.0;  // 1 m/s, the steering free
+            // 1 m/s, the steering free and turned back (δ = π + 0.05: the wheel trails its
+            // steering axis, and swings back to δ = π). At δ = 0 the free wheel leads, an
+            // unstable equilibrium: a steering offset of 1e-15 rad grows until the wheel spins
+            // and the motion breaks down, and the run stays on it only while M's rounding keeps
+            // the steering's acceleration at exactly zero.
+            eta(0) = 1.0;
+            q(c.steer) = std::numbers::pi + 0.05;
           }
           const VectorXd tau = VectorXd::Zero(m);
           const auto f = [&](const VectorXd& x) {

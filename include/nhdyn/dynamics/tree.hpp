@@ -11,8 +11,10 @@
 /// joint's motion is then Rz(q) or Tz(q), the joint subspace is a unit vector, and every
 /// constant (placement of K_i in K_λ(i), m, m·c, the rotational inertia about K_i's origin) is
 /// computed once when the function object is built. Velocities and forces are 3-vectors in
-/// those frames (the Luh–Walker–Paul form of the same recursion); the CRBA builds its
-/// composites in them too, and reads M off in world axes (see tree_crba_kernel_impl).
+/// those frames (the Luh–Walker–Paul form of the same recursion). The CRBA builds its
+/// composites in world axes, each about its own body's origin, and reads M off there
+/// (tree_crba_kernel_world); for intervals and the other scalars that are not floating point,
+/// in the kernel frames (tree_crba_kernel_local).
 #include <Eigen/Core>
 #include <vector>
 
@@ -117,9 +119,46 @@ void tree_rne_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, cons
     tree_rne_kernel_impl<Gravity, Velocity, T>(L, g, q, qd, qdd, tau);
 }
 
-/// The composite-rigid-body algorithm on the kernel constants (RBDA Table 6.2 in 3-vector
-/// form; dynamics/reference.hpp's `crba` is the book's algorithm it optimises, tested equal).
-/// One forward pass and one backward pass:
+/// The CRBA's per-body constants as arrays over the bodies, which its loop over bodies reads
+/// contiguously (and vectorises): I_o about K_i's origin (entries 00, 11, 22, 01, 02, 12),
+/// h = m·c and m, all in K_i. Built once with the function object.
+template <class S>
+struct crba_constants {
+  int n = 0;
+  std::vector<S> v;  ///< 10 arrays of n: I00 I11 I22 I01 I02 I12 h0 h1 h2 m
+  const S* operator[](int k) const { return v.data() + static_cast<std::ptrdiff_t>(k) * n; }
+
+  template <class U>
+  crba_constants<U> cast() const {
+    crba_constants<U> c;
+    c.n = n;
+    c.v.reserve(v.size());
+    for (const S& x : v) c.v.push_back(U(x));
+    return c;
+  }
+};
+
+template <class S>
+crba_constants<S> make_crba_constants(const std::vector<tree_link<S>>& L) {
+  crba_constants<S> c;
+  c.n = static_cast<int>(L.size());
+  c.v.resize(10 * L.size());
+  for (int i = 0; i < c.n; ++i) {
+    const auto& k = L[static_cast<std::size_t>(i)];
+    const S e[10] = {k.Io(0, 0), k.Io(1, 1), k.Io(2, 2), k.Io(0, 1), k.Io(0, 2), k.Io(1, 2), k.h(0), k.h(1), k.h(2), k.m};
+    for (int a = 0; a < 10; ++a) c.v[static_cast<std::size_t>(a * c.n + i)] = e[a];
+  }
+  return c;
+}
+
+/// The composite-rigid-body algorithm in the kernel frames, for the scalars that are not
+/// floating point (intervals, duals, multiprecision; floating point has
+/// tree_crba_kernel_world below). It builds each composite in its own body's kernel frame, so
+/// that an interval's composite is turned by one joint's rotation at a time and M's diagonal is
+/// read in that frame: the enclosures stay narrower than when every body's inertia is turned by
+/// its whole rotation to the world (see the note on intervals there). RBDA Table 6.2 in
+/// 3-vector form; dynamics/reference.hpp's `crba` is the book's algorithm it optimises, tested
+/// equal. One forward pass and one backward pass:
 ///  - forward: each body's placement (R_i, p_i) in its parent's kernel frame, and the kernel
 ///    frame's axes in the world, W_i = W_λ R_i, with w_i = W_λ p_i (the step from λ's origin
 ///    to i's, in world axes);
@@ -136,7 +175,7 @@ void tree_rne_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, cons
 ///    product written as its six entries; on the diagonal 2 (p·a) − 2 a_k p_k is summed as the
 ///    two other terms (no cancellation, and no widening for intervals).
 template <class T, class Q, class Out>
-void tree_crba_kernel_impl(const std::vector<tree_link<T>>& L, const Q& q, Out& H) {
+void tree_crba_kernel_local(const std::vector<tree_link<T>>& L, const Q& q, Out& H) {
   const int n = static_cast<int>(L.size());
   // on the stack up to 32 KiB (110 bodies in double), beyond in a heap block the thread keeps
   // (detail/small_buffer.hpp)
@@ -212,18 +251,152 @@ void tree_crba_kernel_impl(const std::vector<tree_link<T>>& L, const Q& q, Out& 
   }
 }
 
-/// Flattened for the scalars of `flatten_kernels`, as rne is: 4–10 % faster in double (g++ 12
-/// -O3 -march=native, interleaved harness runs of both on the benchmark's trees, 2026-12-01).
+
+/// The composite-rigid-body algorithm for floating point (RBDA Table 6.2 in 3-vector form;
+/// dynamics/reference.hpp's `crba` is the book's algorithm it optimises, tested equal).
+/// Composites in world axes, each about its own body's origin, so that no position is far:
+///  1. forward, per body: K_i's placement (R_i, p_i) in K_λ, its axes in the world
+///     W_i = W_λ R_i, and w_i = W_λ p_i, the step from λ's origin to i's in world axes;
+///  2. a loop over the bodies with no dependence between them (vectorised): each body's own
+///     inertia turned to world axes, I = W I_o Wᵀ (the symmetric product as its six entries),
+///     h = W h, m;
+///  3. backward, at body i once its composite (m, h, I about i's origin, world axes) is
+///     complete: F_i = Ic_i S_i as a moment n about i's origin and a force f (ω = z_i:
+///     f = z × h, n = I z; v = z_i: f = m z, n = h × z), H(i, i) = S_i · F_i; then for each
+///     ancestor j, the moment about j's origin n + d × f with d = Σ w_k from i up to j
+///     (accumulated step by step: only local steps enter), and H(i, j) = z_j · (n + d × f) for a
+///     revolute j, z_j · f for a prismatic one; then the composite moves to λ's origin, with
+///     r = w_i and a = h + (m/2) r: h' = h + m r, I' = I + 2 (r·a) 1 − (a rᵀ + r aᵀ) (the
+///     parallel-axis theorem; on the diagonal 2 (r·a) − 2 a_k r_k is summed as the two other
+///     terms: no cancellation, and no widening for intervals). No rotation in the backward
+///     pass: all are world axes.
+/// The arrays live in one scratch block (22 scalars a body), written as plain scalars, which
+/// g++ 12 and clang 14 both compile to straight-line code.
 template <class T, class Q, class Out>
-NHDYN_FLATTEN void tree_crba_kernel_flat(const std::vector<tree_link<T>>& L, const Q& q, Out& H) {
-  tree_crba_kernel_impl<T>(L, q, H);
+void tree_crba_kernel_world(const std::vector<tree_link<T>>& L, const crba_constants<T>& K, const Q& q, Out& H) {
+  const int n = static_cast<int>(L.size());
+  // on the stack up to 32 KiB (186 bodies in double), beyond in a heap block the thread keeps
+  // (detail/small_buffer.hpp); not zeroed
+  small_buffer<T, dynamic> s(22 * n);
+  const auto arr = [&](int k) { return s.data() + static_cast<std::ptrdiff_t>(k) * n; };
+  // W column-major (W[3c + r] = W(r, c)); its third column is the joint axis z in the world
+  T* __restrict W[9] = {arr(0), arr(1), arr(2), arr(3), arr(4), arr(5), arr(6), arr(7), arr(8)};
+  T* __restrict w[3] = {arr(9), arr(10), arr(11)};
+  T* __restrict hc[3] = {arr(12), arr(13), arr(14)};
+  T* __restrict Ic[6] = {arr(15), arr(16), arr(17), arr(18), arr(19), arr(20)};  // 00 11 22 01 02 12
+  T* __restrict mc = arr(21);
+  // 1. forward
+  for (int i = 0; i < n; ++i) {
+    mat3<T> R;
+    vec3<T> p;
+    kernel_placement(L[i], T(q(i)), R, p);
+    const int l = L[i].parent;
+    if (l < 0) {
+      for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) W[3 * c + r][i] = R(r, c);
+      w[0][i] = w[1][i] = w[2][i] = T(0);
+      continue;
+    }
+    const T l00 = W[0][l], l10 = W[1][l], l20 = W[2][l], l01 = W[3][l], l11 = W[4][l], l21 = W[5][l], l02 = W[6][l],
+            l12 = W[7][l], l22 = W[8][l];
+    for (int c = 0; c < 3; ++c) {
+      const T x = R(0, c), y = R(1, c), z = R(2, c);
+      W[3 * c][i] = l00 * x + l01 * y + l02 * z;
+      W[3 * c + 1][i] = l10 * x + l11 * y + l12 * z;
+      W[3 * c + 2][i] = l20 * x + l21 * y + l22 * z;
+    }
+    w[0][i] = l00 * p(0) + l01 * p(1) + l02 * p(2);
+    w[1][i] = l10 * p(0) + l11 * p(1) + l12 * p(2);
+    w[2][i] = l20 * p(0) + l21 * p(1) + l22 * p(2);
+  }
+  // 2. each body's own inertia in world axes
+  {
+    const T *__restrict J00 = K[0], *__restrict J11 = K[1], *__restrict J22 = K[2], *__restrict J01 = K[3],
+                        *__restrict J02 = K[4], *__restrict J12 = K[5], *__restrict g0 = K[6], *__restrict g1 = K[7],
+                        *__restrict g2 = K[8], *__restrict gm = K[9];
+#if defined(__clang__)
+#pragma clang loop vectorize(assume_safety)
+#elif defined(__GNUC__)
+#pragma GCC ivdep
+#endif
+    for (int i = 0; i < n; ++i) {
+      const T a00 = W[0][i], a10 = W[1][i], a20 = W[2][i], a01 = W[3][i], a11 = W[4][i], a21 = W[5][i], a02 = W[6][i],
+              a12 = W[7][i], a22 = W[8][i];
+      const T j00 = J00[i], j11 = J11[i], j22 = J22[i], j01 = J01[i], j02 = J02[i], j12 = J12[i];
+      const T c00 = a00 * j00 + a01 * j01 + a02 * j02, c01 = a00 * j01 + a01 * j11 + a02 * j12,
+              c02 = a00 * j02 + a01 * j12 + a02 * j22;  // C = W I_o
+      const T c10 = a10 * j00 + a11 * j01 + a12 * j02, c11 = a10 * j01 + a11 * j11 + a12 * j12,
+              c12 = a10 * j02 + a11 * j12 + a12 * j22;
+      const T c20 = a20 * j00 + a21 * j01 + a22 * j02, c21 = a20 * j01 + a21 * j11 + a22 * j12,
+              c22 = a20 * j02 + a21 * j12 + a22 * j22;
+      Ic[0][i] = c00 * a00 + c01 * a01 + c02 * a02;  // (W I_o Wᵀ)(r, k) = C.row(r) · W.row(k)
+      Ic[1][i] = c10 * a10 + c11 * a11 + c12 * a12;
+      Ic[2][i] = c20 * a20 + c21 * a21 + c22 * a22;
+      Ic[3][i] = c00 * a10 + c01 * a11 + c02 * a12;
+      Ic[4][i] = c00 * a20 + c01 * a21 + c02 * a22;
+      Ic[5][i] = c10 * a20 + c11 * a21 + c12 * a22;
+      hc[0][i] = a00 * g0[i] + a01 * g1[i] + a02 * g2[i];
+      hc[1][i] = a10 * g0[i] + a11 * g1[i] + a12 * g2[i];
+      hc[2][i] = a20 * g0[i] + a21 * g1[i] + a22 * g2[i];
+      mc[i] = gm[i];
+    }
+  }
+  // 3. backward
+  H.setZero(n, n);
+  for (int i = n - 1; i >= 0; --i) {
+    const T z0 = W[6][i], z1 = W[7][i], z2 = W[8][i];
+    const T h0 = hc[0][i], h1 = hc[1][i], h2 = hc[2][i];
+    const T m = mc[i];
+    T f0, f1, f2, n0, n1, n2, Hii;
+    if (L[i].revolute) {  // f = z × h, n = I z
+      f0 = z1 * h2 - z2 * h1, f1 = z2 * h0 - z0 * h2, f2 = z0 * h1 - z1 * h0;
+      n0 = Ic[0][i] * z0 + Ic[3][i] * z1 + Ic[4][i] * z2;
+      n1 = Ic[3][i] * z0 + Ic[1][i] * z1 + Ic[5][i] * z2;
+      n2 = Ic[4][i] * z0 + Ic[5][i] * z1 + Ic[2][i] * z2;
+      Hii = z0 * n0 + z1 * n1 + z2 * n2;
+    } else {  // f = m z, n = h × z
+      f0 = m * z0, f1 = m * z1, f2 = m * z2;
+      n0 = h1 * z2 - h2 * z1, n1 = h2 * z0 - h0 * z2, n2 = h0 * z1 - h1 * z0;
+      Hii = m;
+    }
+    if (L[i].has_armature) Hii += L[i].Ia;
+    H(i, i) = Hii;
+    const int l = L[i].parent;
+    if (l < 0) continue;
+    T d0(0), d1(0), d2(0);
+    for (int j = i; L[j].parent >= 0;) {
+      d0 += w[0][j], d1 += w[1][j], d2 += w[2][j];
+      j = L[j].parent;
+      const T y0 = W[6][j], y1 = W[7][j], y2 = W[8][j];
+      // both, then a select: a tree's revolute and prismatic joints mix unpredictably
+      const T m0 = n0 + (d1 * f2 - d2 * f1), m1 = n1 + (d2 * f0 - d0 * f2), m2 = n2 + (d0 * f1 - d1 * f0);
+      const T vr = y0 * m0 + y1 * m1 + y2 * m2, vp = y0 * f0 + y1 * f1 + y2 * f2;
+      const T v = L[j].revolute ? vr : vp;
+      H(i, j) = v;
+      H(j, i) = v;
+    }
+    // the composite of i moves to λ's origin
+    const T r0 = w[0][i], r1 = w[1][i], r2 = w[2][i];
+    const T hm = T(0.5) * m;
+    const T a0 = h0 + hm * r0, a1 = h1 + hm * r1, a2 = h2 + hm * r2;
+    Ic[0][l] += Ic[0][i] + T(2) * (r1 * a1 + r2 * a2);
+    Ic[1][l] += Ic[1][i] + T(2) * (r0 * a0 + r2 * a2);
+    Ic[2][l] += Ic[2][i] + T(2) * (r0 * a0 + r1 * a1);
+    Ic[3][l] += Ic[3][i] - a0 * r1 - r0 * a1;
+    Ic[4][l] += Ic[4][i] - a0 * r2 - r0 * a2;
+    Ic[5][l] += Ic[5][i] - a1 * r2 - r1 * a2;
+    mc[l] += m;
+    hc[0][l] += h0 + m * r0;
+    hc[1][l] += h1 + m * r1;
+    hc[2][l] += h2 + m * r2;
+  }
 }
+
+/// Flattened (every call inside inlined), as rne is for the scalars of `flatten_kernels`.
 template <class T, class Q, class Out>
-void tree_crba_kernel(const std::vector<tree_link<T>>& L, const Q& q, Out& H) {
-  if constexpr (flatten_kernels<T>)
-    tree_crba_kernel_flat<T>(L, q, H);
-  else
-    tree_crba_kernel_impl<T>(L, q, H);
+NHDYN_FLATTEN void tree_crba_kernel_flat(const std::vector<tree_link<T>>& L, const crba_constants<T>& K, const Q& q,
+                                         Out& H) {
+  tree_crba_kernel_world<T>(L, K, q, H);
 }
 
 }  // namespace detail
@@ -358,7 +531,8 @@ tree_rne_fn<S> rne(const tree<S>& t, rne_options o = {}) {
 template <class S>
 class tree_mass_matrix_fn : public stage_tag {
  public:
-  explicit tree_mass_matrix_fn(const tree<S>& t) : links_(detail::make_tree_links(t)), n_(t.dof()) {}
+  explicit tree_mass_matrix_fn(const tree<S>& t)
+      : links_(detail::make_tree_links(t)), consts_(detail::make_crba_constants(links_)), n_(t.dof()) {}
   int dof() const { return n_; }
 
   template <class Q>
@@ -374,14 +548,19 @@ class tree_mass_matrix_fn : public stage_tag {
     static_assert(std::is_same_v<T, promote_t<S, typename Q::Scalar>>, "H's scalar is the model's and q's");
     detail::check_size(q, n_, "q");
     detail::check_finite(q, "q");
-    if constexpr (std::is_same_v<T, S>)
-      detail::tree_crba_kernel<T>(links_, q, H);
+    if constexpr (flatten_kernels<T> && std::is_same_v<T, S>)
+      detail::tree_crba_kernel_flat<T>(links_, consts_, q, H);
+    else if constexpr (flatten_kernels<T>)
+      detail::tree_crba_kernel_flat<T>(detail::cast_links<T>(links_), consts_.template cast<T>(), q, H);
+    else if constexpr (std::is_same_v<T, S>)
+      detail::tree_crba_kernel_local<T>(links_, q, H);
     else
-      detail::tree_crba_kernel<T>(detail::cast_links<T>(links_), q, H);
+      detail::tree_crba_kernel_local<T>(detail::cast_links<T>(links_), q, H);
   }
 
  private:
   std::vector<detail::tree_link<S>> links_;
+  detail::crba_constants<S> consts_;
   int n_;
 };
 
