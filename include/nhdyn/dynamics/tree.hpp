@@ -271,9 +271,11 @@ void tree_crba_kernel_local(const std::vector<tree_link<T>>& L, const Q& q, Out&
 ///     terms: no cancellation, and no widening for intervals). No rotation in the backward
 ///     pass: all are world axes.
 /// The arrays live in one scratch block (22 scalars a body), written as plain scalars, which
-/// g++ 12 and clang 14 both compile to straight-line code.
+/// g++ 12 and clang 14 both compile to straight-line code; H is written through its data
+/// pointer (H is a plain column-major matrix).
 template <class T, class Q, class Out>
 void tree_crba_kernel_world(const std::vector<tree_link<T>>& L, const crba_constants<T>& K, const Q& q, Out& H) {
+  static_assert(!Out::IsRowMajor, "H is written as a column-major matrix");
   const int n = static_cast<int>(L.size());
   // on the stack up to 32 KiB (186 bodies in double), beyond in a heap block the thread keeps
   // (detail/small_buffer.hpp); not zeroed
@@ -343,6 +345,7 @@ void tree_crba_kernel_world(const std::vector<tree_link<T>>& L, const crba_const
   }
   // 3. backward
   H.setZero(n, n);
+  T* const Hd = H.data();  // H(r, c) = Hd[r + c n]: clang 14 leaves Eigen's accessor a call here
   for (int i = n - 1; i >= 0; --i) {
     const T z0 = W[6][i], z1 = W[7][i], z2 = W[8][i];
     const T h0 = hc[0][i], h1 = hc[1][i], h2 = hc[2][i];
@@ -360,7 +363,7 @@ void tree_crba_kernel_world(const std::vector<tree_link<T>>& L, const crba_const
       Hii = m;
     }
     if (L[i].has_armature) Hii += L[i].Ia;
-    H(i, i) = Hii;
+    Hd[i + i * n] = Hii;
     const int l = L[i].parent;
     if (l < 0) continue;
     T d0(0), d1(0), d2(0);
@@ -368,12 +371,15 @@ void tree_crba_kernel_world(const std::vector<tree_link<T>>& L, const crba_const
       d0 += w[0][j], d1 += w[1][j], d2 += w[2][j];
       j = L[j].parent;
       const T y0 = W[6][j], y1 = W[7][j], y2 = W[8][j];
-      // both, then a select: a tree's revolute and prismatic joints mix unpredictably
-      const T m0 = n0 + (d1 * f2 - d2 * f1), m1 = n1 + (d2 * f0 - d0 * f2), m2 = n2 + (d0 * f1 - d1 * f0);
-      const T vr = y0 * m0 + y1 * m1 + y2 * m2, vp = y0 * f0 + y1 * f1 + y2 * f2;
-      const T v = L[j].revolute ? vr : vp;
-      H(i, j) = v;
-      H(j, i) = v;
+      T v;
+      if (L[j].revolute) {
+        const T m0 = n0 + (d1 * f2 - d2 * f1), m1 = n1 + (d2 * f0 - d0 * f2), m2 = n2 + (d0 * f1 - d1 * f0);
+        v = y0 * m0 + y1 * m1 + y2 * m2;
+      } else {
+        v = y0 * f0 + y1 * f1 + y2 * f2;
+      }
+      Hd[i + j * n] = v;
+      Hd[j + i * n] = v;
     }
     // the composite of i moves to λ's origin
     const T r0 = w[0][i], r1 = w[1][i], r2 = w[2][i];
