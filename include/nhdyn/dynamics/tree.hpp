@@ -251,7 +251,6 @@ void tree_crba_kernel_local(const std::vector<tree_link<T>>& L, const Q& q, Out&
   }
 }
 
-
 /// The composite-rigid-body algorithm for floating point (RBDA Table 6.2 in 3-vector form;
 /// dynamics/reference.hpp's `crba` is the book's algorithm it optimises, tested equal).
 /// Composites in world axes, each about its own body's origin, so that no position is far:
@@ -268,8 +267,7 @@ void tree_crba_kernel_local(const std::vector<tree_link<T>>& L, const Q& q, Out&
 ///     revolute j, z_j · f for a prismatic one; then the composite moves to λ's origin, with
 ///     r = w_i and a = h + (m/2) r: h' = h + m r, I' = I + 2 (r·a) 1 − (a rᵀ + r aᵀ) (the
 ///     parallel-axis theorem; on the diagonal 2 (r·a) − 2 a_k r_k is summed as the two other
-///     terms: no cancellation, and no widening for intervals). No rotation in the backward
-///     pass: all are world axes.
+///     terms: no cancellation). No rotation in the backward pass: all are world axes.
 /// The arrays live in one scratch block (22 scalars a body), written as plain scalars, which
 /// g++ 12 and clang 14 both compile to straight-line code; H is written through its data
 /// pointer (H is a plain column-major matrix).
