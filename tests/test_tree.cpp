@@ -139,36 +139,39 @@ TEST_CASE("tree rne and CRBA into reused storage (evaluate) give the calls' numb
 }
 
 TEST_CASE("tree CRBA: M does not depend on where a planar base stands, even 1e6 m away", "[tree][extremes]") {
-  // a planar base (x, y slides, then a yaw) carrying a random branching robot: M(q) depends on
-  // neither x nor y, so M at x = y = 1e6 m must be M at the origin. The kernel's composites sit
-  // at their own bodies' origins and its lever arms are sums of local steps, so nothing far
-  // enters (it gives the same M bit for bit here). The same algorithm about one reference point,
-  // the root's origin, is off by 2e-11 to 5e-11 of max |M| on these trees (measured).
+  // a planar base (x, y slides, then a yaw) on a vertical slide, carrying a random branching
+  // robot: M(q) depends on neither x nor y, so M at x = y = 1e6 m must be M at the origin. (The
+  // vertical slide comes first so that x and y are not the root's joint, whose placement no
+  // kernel needs.) The kernel's composites sit at their own bodies' origins and its lever arms
+  // are sums of local steps, so nothing far enters (it gives the same M bit for bit here). The
+  // same algorithm about one reference point, the root's origin, is off by 2e-11 to 6e-11 of
+  // max |M| on such trees (measured).
   std::mt19937_64 rng(43);
   for (int rep = 0; rep < 3; ++rep) {
     const tree<double> arm = nhdyn_ref::random_tree(rng, 20);
-    std::vector<body<double>> B(3);
-    const Eigen::Vector3d axes[3] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()};
-    for (int k = 0; k < 3; ++k) {
+    std::vector<body<double>> B(4);
+    const Eigen::Vector3d axes[4] = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+                                     Eigen::Vector3d::UnitZ()};
+    for (int k = 0; k < 4; ++k) {
       B[std::size_t(k)].name = "base" + std::to_string(k);
       B[std::size_t(k)].joint_name = "base_joint" + std::to_string(k);
       B[std::size_t(k)].parent = k - 1;
-      B[std::size_t(k)].joint = k < 2 ? joint_type::prismatic : joint_type::revolute;
+      B[std::size_t(k)].joint = k < 3 ? joint_type::prismatic : joint_type::revolute;
       B[std::size_t(k)].axis = axes[k];
     }
-    B[2].mass = 30;
-    B[2].inertia = Eigen::Vector3d(1.2, 1.5, 2.0).asDiagonal();
+    B[3].mass = 30;
+    B[3].inertia = Eigen::Vector3d(1.2, 1.5, 2.0).asDiagonal();
     for (body<double> b : arm.bodies()) {
-      b.parent = b.parent < 0 ? 2 : b.parent + 3;
+      b.parent = b.parent < 0 ? 3 : b.parent + 4;
       B.push_back(b);
     }
     const tree<double> t(B, Eigen::Vector3d(0, 0, -9.81), "planar base");
     const int n = t.dof();
     VectorXd q = random_state(rng, n);
-    q(0) = q(1) = 0;
+    q(1) = q(2) = 0;
     const MatrixXd M0 = mass_matrix(t)(q);
     CHECK(rel(M0, reference::crba<double>(t, q)) < 1e-13);
-    q(0) = q(1) = 1e6;
+    q(1) = q(2) = 1e6;
     const MatrixXd M1 = mass_matrix(t)(q);
     INFO("rep " << rep);
     CHECK((M1 - M0).cwiseAbs().maxCoeff() <= 1e-13 * M0.cwiseAbs().maxCoeff());
@@ -187,6 +190,10 @@ TEST_CASE("tree kernels equal the reference for float, duals and intervals", "[t
     const Eigen::VectorXf v = rne(tf)(q.cast<float>(), qd.cast<float>(), qdd.cast<float>());
     CHECK(rel(v.cast<double>(), ref) < 2e-4);
     CHECK(rel(mass_matrix(tf)(q.cast<float>()).cast<double>(), reference::crba<double>(t, q)) < 2e-4);
+    // a float model at a double state: the kernel runs in double on the float model's constants
+    // (cast, with its arrays of constants, to double)
+    const Eigen::MatrixXd Mfd = mass_matrix(tf)(q);
+    CHECK(rel(Mfd, reference::crba<double>(t, q)) < 2e-4);
   }
   SECTION("duals: the kernel's derivative is the reference's") {
     using D = dual<double, 2>;

@@ -269,11 +269,11 @@ TEST_CASE("wheeled robots: an unforced 10 s motion keeps A q_dot = 0 and the ene
             eta(0) = 10.0;  // wheel rates [rad/s]: about 1 m/s, turning
             eta(1) = 8.0;
           } else {
-            // 1 m/s, the steering free and turned back (δ = π + 0.05: the wheel trails its
-            // steering axis, and swings back to δ = π). At δ = 0 the free wheel leads, an
-            // unstable equilibrium: a steering offset of 1e-15 rad grows until the wheel spins
-            // and the motion breaks down, and the run stays on it only while M's rounding keeps
-            // the steering's acceleration at exactly zero.
+            // 1 m/s, the steering free and turned half a turn (δ = π + 0.05), where it is
+            // stable: it swings back to δ = π. δ = 0 is an unstable equilibrium: a steering
+            // offset of 1e-15 rad grows until the steering spins and the motion breaks down,
+            // and the run stays on it only while M's rounding keeps the steering's
+            // acceleration at exactly zero.
             eta(0) = 1.0;
             q(c.steer) = std::numbers::pi + 0.05;
           }
