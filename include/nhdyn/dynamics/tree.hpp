@@ -127,15 +127,6 @@ struct crba_constants {
   int n = 0;
   std::vector<S> v;  ///< 10 arrays of n: I00 I11 I22 I01 I02 I12 h0 h1 h2 m
   const S* operator[](int k) const { return v.data() + static_cast<std::ptrdiff_t>(k) * n; }
-
-  template <class U>
-  crba_constants<U> cast() const {
-    crba_constants<U> c;
-    c.n = n;
-    c.v.reserve(v.size());
-    for (const S& x : v) c.v.push_back(U(x));
-    return c;
-  }
 };
 
 template <class S>
@@ -556,9 +547,10 @@ class tree_mass_matrix_fn : public stage_tag {
     detail::check_finite(q, "q");
     if constexpr (flatten_kernels<T> && std::is_same_v<T, S>)
       detail::tree_crba_kernel_flat<T>(links_, consts_, q, H);
-    else if constexpr (flatten_kernels<T>)
-      detail::tree_crba_kernel_flat<T>(detail::cast_links<T>(links_), consts_.template cast<T>(), q, H);
-    else if constexpr (std::is_same_v<T, S>)
+    else if constexpr (flatten_kernels<T>) {
+      const auto L = detail::cast_links<T>(links_);
+      detail::tree_crba_kernel_flat<T>(L, detail::make_crba_constants(L), q, H);
+    } else if constexpr (std::is_same_v<T, S>)
       detail::tree_crba_kernel_local<T>(links_, q, H);
     else
       detail::tree_crba_kernel_local<T>(detail::cast_links<T>(links_), q, H);
