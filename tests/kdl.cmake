@@ -2,11 +2,12 @@
 # liborocos-kdl-dev. tests/test_kdl_reference.cpp is built either way; without KDL it only
 # reports that the comparison was skipped.
 find_package(orocos_kdl QUIET)
-if(TARGET test_kdl_reference)
+nhdyn_test_target(test_kdl_reference _target)
+if(TARGET ${_target})
   if(orocos_kdl_FOUND)
-    target_include_directories(test_kdl_reference SYSTEM PRIVATE ${orocos_kdl_INCLUDE_DIRS})
-    target_link_libraries(test_kdl_reference PRIVATE ${orocos_kdl_LIBRARIES})
-    target_compile_definitions(test_kdl_reference PRIVATE NHDYN_HAVE_KDL=1)
+    target_include_directories(${_target} SYSTEM PRIVATE ${orocos_kdl_INCLUDE_DIRS})
+    target_link_libraries(${_target} PRIVATE ${orocos_kdl_LIBRARIES})
+    target_compile_definitions(${_target} PRIVATE NHDYN_HAVE_KDL=1)
   else()
     message(STATUS "nhdyn tests: Orocos KDL (liborocos-kdl-dev) not found: test_kdl_reference is skipped")
   endif()

@@ -2,8 +2,9 @@
 # (target nhdyn_tool, from examples/nhdyn_tool.cmake), whose path they get as
 # NHDYN_TOOL_PATH. tests/tool/test_*.cpp each become one executable and ctest entry.
 find_package(nlohmann_json 3 REQUIRED)
-if(TARGET test_model_io)
-  target_link_libraries(test_model_io PRIVATE nlohmann_json::nlohmann_json)
+nhdyn_test_target(test_model_io _target)
+if(TARGET ${_target})
+  target_link_libraries(${_target} PRIVATE nlohmann_json::nlohmann_json)
 endif()
 if(TARGET nhdyn_tool)
   file(GLOB NHDYN_TOOL_TEST_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/tool/test_*.cpp)
