@@ -5,7 +5,6 @@
 # where it is built (nhdyn_link_loaders), so both ways are compiled and tested.
 # A test's program is its group's (tests/CMakeLists.txt, nhdyn_test_target): test_urdf's group
 # links nhdyn::urdf header-only, the others' groups nhdyn::compiled.
-set(_skipped "")
 foreach(t test_urdf test_wheeled_base test_wheel_kinds test_robot_simulation test_derivatives test_scene_terms)
   nhdyn_test_target(${t} _target)
   if(TARGET ${_target})
@@ -13,9 +12,8 @@ foreach(t test_urdf test_wheeled_base test_wheel_kinds test_robot_simulation tes
       target_link_libraries(${_target} PRIVATE nhdyn::urdf)
     elseif(TARGET nhdyn::urdf)
       nhdyn_link_loaders(${_target})
-    elseif(NOT _target IN_LIST _skipped)
+    else()
       nhdyn_skip_test_target(${_target} "urdfdom or tinyxml2 not found")
-      list(APPEND _skipped ${_target})
     endif()
   endif()
 endforeach()
