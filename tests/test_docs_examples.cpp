@@ -14,6 +14,7 @@
 #ifdef NHDYN_HAVE_URDF
 #include <nhdyn/io/robot_file.hpp>
 #include <nhdyn/io/urdf.hpp>
+#include <nhdyn/robot_dynamics.hpp>
 #endif
 #include <numbers>
 #include <random>
@@ -220,6 +221,45 @@ TEST_CASE("docs/api.md §6: any wheels: a mecanum base's least-norm wheel torque
   // the shipped robot file builds the same constraint
   const auto file = nhdyn::io::load_robot_file(dir + "/examples/robots/mecanum_arm.json");
   CHECK(rel(nhdyn::inverse_dynamics(file.model, std::get<nhdyn::wheeled_base<double>>(*file.constraint))(q, eta, eta_dot), tau) < 1e-15);
+}
+#endif
+
+#ifdef NHDYN_HAVE_URDF
+TEST_CASE("docs/api.md §11: robot_dynamics gives the template API's numbers, and v = E tau + A^T lambda") {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> U(-1, 1);
+  const auto random = [&](int n) { return Eigen::VectorXd(Eigen::VectorXd::NullaryExpr(n, [&] { return U(rng); })); };
+  const Eigen::VectorXd q = random(12), eta = random(8), eta_dot = random(8);
+  Eigen::VectorXd tau_reused;
+  const std::string dir = NHDYN_SOURCE_DIR;
+  // snippet (the path made absolute: the test runs in any folder)
+  const auto robot = nhdyn::robot_dynamics::load(dir + "/examples/robots/mecanum_arm.json");
+  // a preset, a URDF, a robot file or a JSON model; robot.dof() = n, m(), k(), p(), the names
+  const Eigen::VectorXd tau = robot.inverse_dynamics(q, eta, eta_dot);  // project ∘ rne ∘ lift
+  const auto f = robot.inverse_dynamics_with_forces(q, eta, eta_dot);   // f.tau, f.lambda
+  const Eigen::VectorXd eta_ddot = robot.nh_forward_dynamics(q, eta, f.tau);  // = eta_dot
+  const auto xi = robot.lift(q, eta, eta_dot);                           // xi.q, xi.qd, xi.qdd
+  const Eigen::VectorXd v = robot.rne(xi.q, xi.qd, xi.qdd);              // = E τ + Aᵀλ
+  const Eigen::MatrixXd M = robot.mass_matrix(q), E = robot.input_map(q), A = robot.A(q);
+  const auto lin = robot.nh_forward_dynamics_derivatives(q, eta, f.tau);  // lin.A, lin.B: ẋ = f(x, τ)
+  robot.inverse_dynamics(q, eta, eta_dot, tau_reused);                   // into storage, no allocation
+  // end snippet
+  CHECK(robot.dof() == 12);
+  CHECK(robot.m() == 8);
+  CHECK(robot.k() == 4);
+  CHECK(robot.p() == 9);
+  CHECK(tau_reused == tau);
+  CHECK(f.tau == tau);
+  CHECK(rel(eta_ddot, eta_dot) < 1e-9);
+  CHECK(rel(E * f.tau + A.transpose() * f.lambda, v) < 1e-10);
+  CHECK(relm(M, M.transpose()) < 1e-15);
+  CHECK(lin.A.rows() == 20);
+  CHECK(lin.B.cols() == 9);
+  // the template API on the same file: the same τ (compiled in the library or here)
+  const auto file = nhdyn::io::load_robot_file(dir + "/examples/robots/mecanum_arm.json");
+  const auto& c = std::get<nhdyn::wheeled_base<double>>(*file.constraint);
+  CHECK(rel(nhdyn::inverse_dynamics(file.model, c)(q, eta, eta_dot), tau) < 1e-15);
+  CHECK(relm(nhdyn::mass_matrix(file.model)(q), M) < 1e-15);
 }
 #endif
 

@@ -5,7 +5,8 @@
 # where it is built (nhdyn_link_loaders), so both ways are compiled and tested.
 # A test's program is its group's (tests/CMakeLists.txt, nhdyn_test_target): test_urdf's group
 # links nhdyn::urdf header-only, the others' groups nhdyn::compiled.
-foreach(t test_urdf test_wheeled_base test_wheel_kinds test_robot_simulation test_derivatives test_scene_terms)
+foreach(t test_urdf test_wheeled_base test_wheel_kinds test_robot_simulation test_derivatives test_scene_terms
+        test_robot_dynamics)
   nhdyn_test_target(${t} _target)
   if(TARGET ${_target})
     if(TARGET nhdyn::urdf AND t STREQUAL "test_urdf")

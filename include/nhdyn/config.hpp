@@ -3,8 +3,9 @@
 /// Header-only or compiled (issue 33 item 4). nhdyn is header-only; the optional library
 /// `nhdyn::compiled` (CMake target, built by default when urdfdom, tinyxml2, nlohmann_json and
 /// Boost are found) holds the file loaders (io/urdf.hpp, io/robot_file.hpp), `simulate_scene`
-/// and `lyapunov_P` (simulation/) compiled once, so that a program that links it does not
-/// compile them again in every file that includes them (docs/install.md lists them).
+/// and `lyapunov_P` (simulation/), and `robot_dynamics` (robot_dynamics.hpp), compiled once, so
+/// that a program that links it does not compile them again in every file that includes them
+/// (docs/install.md lists them).
 ///
 /// - Header-only (nothing defined): every function is defined in its header, `inline`.
 /// - `NHDYN_COMPILED` (set by linking `nhdyn::compiled`): the headers declare the compiled
@@ -20,6 +21,7 @@
 /// The parts of nhdyn::compiled, one source file each (src/compiled/).
 #define NHDYN_PART_IO 1          ///< io/urdf.hpp, io/robot_file.hpp (src/compiled/io.cpp)
 #define NHDYN_PART_SIMULATION 2  ///< simulation/robot_scene.hpp, controller.hpp (simulation.cpp)
+#define NHDYN_PART_DYNAMICS 3    ///< robot_dynamics.hpp (dynamics.cpp)
 
 /// NHDYN_DEFINES(part): whether this translation unit defines the part's compiled functions.
 #if defined(NHDYN_COMPILED_SOURCE)

@@ -2,7 +2,9 @@
 /// Header-only or compiled, the same numbers (issue 33 item 4; include/nhdyn/config.hpp).
 /// Prints in hexadecimal floating point everything the URDF and robot-file loaders give for
 /// each shipped robot file: every body's constants, the frames, gravity; the constraint's A(q)
-/// and S(q)η at a state; and one rne at that state. Then the first 0.3 s of three shipped scenes
+/// and S(q)η at a state; and one rne at that state; then every call of robot_dynamics (the front
+/// end with no templates, robot_dynamics.hpp) at a state, its rne and inverse dynamics checked
+/// equal to the template API's bit for bit. Then the first 0.3 s of three shipped scenes
 /// (`simulate_scene`: a mecanum base, the wheeled mobile manipulator, paper5 as a DH chain),
 /// every logged row. tests/compiled.cmake builds this file
 /// twice, linking nhdyn::compiled and header-only, and its ctest entry compares the two
@@ -16,6 +18,8 @@
 
 #include <nhdyn/dynamics/tree.hpp>
 #include <nhdyn/io/robot_file.hpp>
+#include <nhdyn/nhdyn.hpp>
+#include <nhdyn/robot_dynamics.hpp>
 #include <nhdyn/simulation/robot_scene.hpp>
 #include <nhdyn/simulation/scene.hpp>
 
@@ -66,6 +70,45 @@ int main(int argc, char** argv) {
           },
           *r.constraint);
     for (const auto& name : r.tau_names()) std::printf("tau %s\n", name.c_str());
+
+    // robot_dynamics: every call, compiled (in nhdyn::compiled) or header-only (inline here)
+    const nhdyn::robot_dynamics rd(r);
+    const Eigen::VectorXd v = rd.rne(q, qd, qdd);
+    if (v != nhdyn::rne(t)(q, qd, qdd)) {
+      std::fprintf(stderr, "same_numbers: %s: robot_dynamics::rne differs from rne(tree)\n", f.c_str());
+      return 1;
+    }
+    put("rd rne", v), put("rd M", rd.mass_matrix(q)), put("rd bias", rd.bias(q, qd));
+    put("rd fd", rd.forward_dynamics(q, qd, v));
+    const auto d = rd.rne_derivatives(q, qd, qdd);
+    put("rd drne", d.tau), put(" dq", d.dq), put(" dqd", d.dqd), put(" M", d.M);
+    const auto fdd = rd.forward_dynamics_derivatives(q, qd, v);
+    put("rd dfd", fdd.qdd), put(" dq", fdd.dq), put(" dqd", fdd.dqd), put(" Minv", fdd.Minv);
+    if (rd.constrained()) {
+      Eigen::VectorXd eta(rd.m()), eta_dot(rd.m());
+      for (int i = 0; i < rd.m(); ++i) eta(i) = 0.2 * i - 0.4, eta_dot(i) = std::cos(0.9 * i);
+      const auto forces = rd.inverse_dynamics_with_forces(q, eta, eta_dot);
+      const bool same = std::visit(
+          [&](const auto& c) {
+            const auto ref = nhdyn::inverse_dynamics_with_forces(t, c)(q, eta, eta_dot);
+            return forces.tau == ref.tau && forces.lambda == ref.lambda;
+          },
+          *r.constraint);
+      if (!same) {
+        std::fprintf(stderr, "same_numbers: %s: robot_dynamics::inverse_dynamics_with_forces differs from "
+                     "inverse_dynamics_with_forces(tree, c)\n", f.c_str());
+        return 1;
+      }
+      put("rd tau", forces.tau), put("rd lambda", forces.lambda), put("rd id", rd.inverse_dynamics(q, eta, eta_dot));
+      put("rd fd eta", rd.nh_forward_dynamics(q, eta, forces.tau));
+      const auto xi = rd.lift(q, eta, eta_dot);
+      put("rd lift", xi.q), put(" qd", xi.qd), put(" qdd", xi.qdd);
+      put("rd S eta", rd.apply_S(q, eta)), put("rd S", rd.S(q)), put("rd A", rd.A(q)), put("rd E", rd.input_map(q));
+      const auto did = rd.inverse_dynamics_derivatives(q, eta, eta_dot);
+      put("rd did", did.tau), put(" dq", did.dq), put(" deta", did.deta), put(" deta_dot", did.deta_dot);
+      const auto dfd = rd.nh_forward_dynamics_derivatives(q, eta, forces.tau);
+      put("rd dnhfd", dfd.eta_dot), put(" A", dfd.A), put(" B", dfd.B);
+    }
   }
   for (const char* name : {"mecanum-sideways-circle", "mobile-manipulator-circle", "paper-circle"}) {
     auto f = nhdyn::scene::open(std::string(argv[2]) + "/" + name + ".json");

@@ -21,6 +21,7 @@ LAYERS = [
     ["analysis"],      # linearisation, bounds
     ["io"],            # files
     ["simulation"],
+    ["robot_dynamics.hpp"],  # a loaded robot's double dynamics behind a class with no templates
     ["nhdyn.hpp"],     # everything
 ]
 __doc__ += "\n    " + " < ".join("/".join(l) for l in LAYERS)

@@ -103,6 +103,10 @@ NHDYN_COMPILED_INLINE robot_model parse_robot_file(const std::string& text, cons
 NHDYN_COMPILED_INLINE std::optional<robot_constraint> constraint_on(const robot_model& r, const tree<double>& t);
 /// The robot file at `path`.
 NHDYN_COMPILED_INLINE robot_model load_robot_file(const std::string& path, urdf_options opt = {});
+/// The robot that `spec` names, whatever it is: a preset (io::preset_names), a URDF (`.urdf`:
+/// no constraint), a robot file (a JSON object with "urdf") or a JSON model (a DH chain, as a
+/// tree: as_robot). The loader of scenes, robot_dynamics and the tool's robot arguments.
+NHDYN_COMPILED_INLINE robot_model load_robot(const std::string& spec);
 
 #if NHDYN_DEFINES(NHDYN_PART_IO)
 namespace detail {
@@ -444,6 +448,25 @@ NHDYN_COMPILED_INLINE std::optional<robot_constraint> constraint_on(const robot_
   return detail::read_robot_constraint(r.constraint_source, t, detail::place{"robot file '" + r.path + "'"}, opt);
 }
 
+NHDYN_COMPILED_INLINE robot_model load_robot(const std::string& spec) {
+  const auto presets = preset_names();
+  std::string ext = std::filesystem::path(spec).extension().string();
+  for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  if (ext == ".urdf") {
+    tree<double> t = load_urdf(spec);
+    std::string name = t.name();
+    return robot_model{.model = std::move(t), .constraint = std::nullopt, .name = std::move(name),
+                       .constraint_source = {}, .path = spec, .planar_base = false};
+  }
+  const bool preset = std::find(presets.begin(), presets.end(), spec) != presets.end();
+  if (!preset) {
+    std::ifstream in(spec);
+    if (const auto j = json::parse(in, nullptr, false); j.is_object() && j.contains("urdf")) return load_robot_file(spec);
+  }
+  robot_model r = as_robot(load<double>(spec), "robot '" + spec + "', locked: ");
+  r.path = spec;
+  return r;
+}
 NHDYN_COMPILED_INLINE robot_model load_robot_file(const std::string& path, urdf_options opt) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw model_error("robot file '" + path + "': cannot open the file");

@@ -89,29 +89,8 @@ inline tree<double> with_length_factors(const tree<double>& t, const std::vector
 }
 
 /// The robot a scene names (not paper5, which `simulate` runs): a preset, a URDF, a robot file
-/// or a JSON model, as a tree with its optional constraint. (In nhdyn::compiled.)
-NHDYN_COMPILED_INLINE io::robot_model load_scene_robot(const std::string& robot);
-#if NHDYN_DEFINES(NHDYN_PART_SIMULATION)
-NHDYN_COMPILED_INLINE io::robot_model load_scene_robot(const std::string& robot) {
-  const auto presets = io::preset_names();
-  std::string ext = std::filesystem::path(robot).extension().string();
-  for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-  if (ext == ".urdf") {
-    tree<double> t = io::load_urdf(robot);
-    std::string name = t.name();
-    return io::robot_model{.model = std::move(t), .constraint = std::nullopt, .name = std::move(name),
-                           .constraint_source = {}, .path = robot, .planar_base = false};
-  }
-  const bool preset = std::find(presets.begin(), presets.end(), robot) != presets.end();
-  if (!preset) {
-    std::ifstream in(robot);
-    if (const auto j = nlohmann::json::parse(in, nullptr, false); j.is_object() && j.contains("urdf")) return io::load_robot_file(robot);
-  }
-  io::robot_model r = io::as_robot(io::load<double>(robot), "robot '" + robot + "', locked: ");
-  r.path = robot;
-  return r;
-}
-#endif
+/// or a JSON model, as a tree with its optional constraint (io::load_robot).
+inline io::robot_model load_scene_robot(const std::string& robot) { return io::load_robot(robot); }
 
 namespace detail {
 /// A scene's robot set up as trees (see the file comment): plant and nominal model, the

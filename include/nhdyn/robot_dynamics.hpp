@@ -1,0 +1,370 @@
+#pragma once
+/// \file robot_dynamics.hpp
+/// `robot_dynamics`: a loaded robot's dynamics in double behind an interface with no templates.
+/// It is the fast-to-compile front end (issue 33 item 4). The function objects (rne, inverse_dynamics,
+/// …) are the library; this class calls them and adds nothing to their numbers.
+///
+///     auto robot = nhdyn::robot_dynamics::load("my_robot.json");  // a robot file, URDF, JSON model or preset
+///     Eigen::VectorXd tau = robot.inverse_dynamics(q, eta, eta_dot);  // project ∘ rne ∘ lift
+///
+/// Linked with `nhdyn::compiled`, this header declares the class and includes only Eigen/Core and
+/// the standard library. Everything is compiled once, in the library (src/compiled/dynamics.cpp).
+/// On this machine, examples/wheeled_robot.cpp compiles in seconds instead of the full headers'
+/// tens of seconds (docs/performance.md, "Compile times").
+///
+/// Header-only (no nhdyn::compiled): this header includes the library and defines the class
+/// inline, from the same code. The same program gives the same numbers bit for bit either way
+/// (tests/compiled/).
+///
+/// Coverage: trees with any built-in base constraint (io::robot_constraint) or none. A DH model
+/// (a JSON model file, a preset) runs as its tree (io::as_robot), and the numbers differ from the
+/// chain kernels' only by rounding. Scalars other than double, fixed sizes, friction, applied
+/// wrenches and user constraints need the template API (nhdyn.hpp); `robot()` gives the loaded
+/// robot for it. Every call checks its arguments' sizes and finiteness, and throws nhdyn::error
+/// (errors.hpp) naming the argument. A nonholonomic call on a robot without a constraint throws
+/// model_error. A robot_dynamics is immutable: copies share one model, and concurrent calls
+/// from several threads are safe.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "config.hpp"
+#include "detail/compiled_abi.hpp"
+#include "errors.hpp"
+
+namespace nhdyn {
+namespace io {
+struct robot_model;
+}
+
+/// ξ = (q, q̇, q̈): a joint state (the lift's output).
+struct robot_state {
+  Eigen::VectorXd q, qd, qdd;
+};
+/// τ and the constraint forces λ (inverse_dynamics_with_forces).
+struct robot_forces {
+  Eigen::VectorXd tau, lambda;
+};
+/// τ = rne(q, q̇, q̈) and its derivatives: ∂τ/∂q, ∂τ/∂q̇, ∂τ/∂q̈ = M(q).
+struct rne_partials {
+  Eigen::VectorXd tau;
+  Eigen::MatrixXd dq, dqd, M;
+};
+/// q̈ of the holonomic forward dynamics and its derivatives: ∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂τ = M⁻¹.
+struct forward_partials {
+  Eigen::VectorXd qdd;
+  Eigen::MatrixXd dq, dqd, Minv;
+};
+/// τ of the nonholonomic inverse dynamics and its derivatives: ∂τ/∂q, ∂τ/∂η, ∂τ/∂η̇.
+struct nh_inverse_partials {
+  Eigen::VectorXd tau;
+  Eigen::MatrixXd dq, deta, deta_dot;
+};
+/// η̇ of the constrained forward dynamics and the state-space model ẋ = f(x, τ) for x = (q, η),
+/// linearised: A = ∂f/∂x ((n+m) × (n+m)), B = ∂f/∂τ ((n+m) × p).
+struct nh_forward_partials {
+  Eigen::VectorXd eta_dot;
+  Eigen::MatrixXd A, B;
+};
+
+class robot_dynamics {
+ public:
+  /// A vector argument: an Eigen vector of double, a segment, a map (read in place when
+  /// contiguous).
+  using vector_arg = const Eigen::Ref<const Eigen::VectorXd>&;
+
+  /// The robot that `robot` names: a preset, a URDF, a robot file (a URDF with its base
+  /// constraint, docs/model-format.md) or a JSON model (io::load_robot, the scenes' loader).
+  NHDYN_COMPILED_INLINE static robot_dynamics load(const std::string& robot);
+  /// A robot already loaded (io::load_robot_file, io::as_robot, io::lock_robot).
+  NHDYN_COMPILED_INLINE explicit robot_dynamics(const io::robot_model& robot);
+
+  /// The loaded robot: its tree and its constraint, for the template API (io/robot_file.hpp).
+  NHDYN_COMPILED_INLINE const io::robot_model& robot() const;
+  NHDYN_COMPILED_INLINE const std::string& name() const;
+  /// n (the size of q, q̇, q̈, v), m (of η; n without a constraint), k (constraint rows; 0
+  /// without one), p (of τ for inverse_dynamics; m but for wheeled bases with other actuators).
+  NHDYN_COMPILED_INLINE int dof() const;
+  NHDYN_COMPILED_INLINE int m() const;
+  NHDYN_COMPILED_INLINE int k() const;
+  NHDYN_COMPILED_INLINE int p() const;
+  NHDYN_COMPILED_INLINE bool constrained() const;
+  /// The names of q's, η's and τ's entries.
+  NHDYN_COMPILED_INLINE const std::vector<std::string>& joint_names() const;
+  NHDYN_COMPILED_INLINE const std::vector<std::string>& eta_names() const;
+  NHDYN_COMPILED_INLINE const std::vector<std::string>& tau_names() const;
+  /// The index of a name in joint_names(), eta_names() or tau_names(); model_error naming it
+  /// and the names there are when it is not one of them.
+  NHDYN_COMPILED_INLINE int joint_index(const std::string& joint) const;
+  NHDYN_COMPILED_INLINE int eta_index(const std::string& name) const;
+  NHDYN_COMPILED_INLINE int tau_index(const std::string& name) const;
+
+  // The tree as if the base were free: the holonomic dynamics (dynamics/).
+  /// v = M(q)q̈ + C(q, q̇)q̇ + g(q) (rne); the second form writes v (resized to n).
+  NHDYN_COMPILED_INLINE Eigen::VectorXd rne(vector_arg q, vector_arg qd, vector_arg qdd) const;
+  NHDYN_COMPILED_INLINE void rne(vector_arg q, vector_arg qd, vector_arg qdd, Eigen::VectorXd& v) const;
+  /// M(q) by the composite-rigid-body algorithm; the second form writes M (resized to n × n).
+  NHDYN_COMPILED_INLINE Eigen::MatrixXd mass_matrix(vector_arg q) const;
+  NHDYN_COMPILED_INLINE void mass_matrix(vector_arg q, Eigen::MatrixXd& M) const;
+  /// h(q, q̇) = C(q, q̇)q̇ + g(q).
+  NHDYN_COMPILED_INLINE Eigen::VectorXd bias(vector_arg q, vector_arg qd) const;
+  /// q̈ = M⁻¹(τ − h) (forward_dynamics: ABA or CRBA + LDLᵀ, as it chooses for the tree).
+  NHDYN_COMPILED_INLINE Eigen::VectorXd forward_dynamics(vector_arg q, vector_arg qd, vector_arg tau) const;
+  NHDYN_COMPILED_INLINE rne_partials rne_derivatives(vector_arg q, vector_arg qd, vector_arg qdd) const;
+  NHDYN_COMPILED_INLINE forward_partials forward_dynamics_derivatives(vector_arg q, vector_arg qd,
+                                                                      vector_arg tau) const;
+
+  // The robot on its base constraint: the nonholonomic dynamics (constraints/, analysis/).
+  /// τ = (SᵀE)⁻¹Sᵀ rne(lift(q, η, η̇)) (project ∘ rne ∘ lift); the second form writes τ
+  /// (resized to p) with no allocation.
+  NHDYN_COMPILED_INLINE Eigen::VectorXd inverse_dynamics(vector_arg q, vector_arg eta, vector_arg eta_dot) const;
+  NHDYN_COMPILED_INLINE void inverse_dynamics(vector_arg q, vector_arg eta, vector_arg eta_dot,
+                                              Eigen::VectorXd& tau) const;
+  /// τ and the constraint forces λ: rne(lift(q, η, η̇)) = E(q)τ + A(q)ᵀλ.
+  NHDYN_COMPILED_INLINE robot_forces inverse_dynamics_with_forces(vector_arg q, vector_arg eta,
+                                                                  vector_arg eta_dot) const;
+  /// η̇ from τ (nh_forward_dynamics).
+  NHDYN_COMPILED_INLINE Eigen::VectorXd nh_forward_dynamics(vector_arg q, vector_arg eta, vector_arg tau) const;
+  /// ξ = (q, S(q)η, S(q)η̇ + Ṡ(q, η)η).
+  NHDYN_COMPILED_INLINE robot_state lift(vector_arg q, vector_arg eta, vector_arg eta_dot) const;
+  /// q̇ = S(q)η.
+  NHDYN_COMPILED_INLINE Eigen::VectorXd apply_S(vector_arg q, vector_arg eta) const;
+  /// S(q) (n × m), A(q) (k × n; A S = 0), E(q) (n × p: the actuators' map, S where τ is η's).
+  NHDYN_COMPILED_INLINE Eigen::MatrixXd S(vector_arg q) const;
+  NHDYN_COMPILED_INLINE Eigen::MatrixXd A(vector_arg q) const;
+  NHDYN_COMPILED_INLINE Eigen::MatrixXd input_map(vector_arg q) const;
+  NHDYN_COMPILED_INLINE nh_inverse_partials inverse_dynamics_derivatives(vector_arg q, vector_arg eta,
+                                                                         vector_arg eta_dot) const;
+  NHDYN_COMPILED_INLINE nh_forward_partials nh_forward_dynamics_derivatives(vector_arg q, vector_arg eta,
+                                                                            vector_arg tau) const;
+
+ private:
+  struct impl;
+  std::shared_ptr<const impl> p_;
+};
+
+}  // namespace nhdyn
+
+#if NHDYN_DEFINES(NHDYN_PART_DYNAMICS)
+#include <algorithm>
+#include <optional>
+#include <variant>
+
+#include "analysis/derivatives.hpp"
+#include "constraints/forward_dynamics.hpp"
+#include "constraints/stages.hpp"
+#include "dynamics/forward_dynamics.hpp"
+#include "dynamics/rne_derivatives.hpp"
+#include "dynamics/tree.hpp"
+#include "io/robot_file.hpp"
+
+namespace nhdyn {
+namespace detail {
+/// The nonholonomic function objects of one constraint type C on a tree.
+template <class C>
+struct robot_dynamics_nh {
+  using tree_t = tree<double>;
+  C c;
+  decltype(inverse_dynamics(std::declval<const tree_t&>(), std::declval<const C&>())) id;
+  decltype(inverse_dynamics_with_forces(std::declval<const tree_t&>(), std::declval<const C&>())) id_forces;
+  decltype(nh_forward_dynamics(std::declval<const tree_t&>(), std::declval<const C&>())) fd;
+  lift_fn<C> lifting;
+  decltype(inverse_dynamics_derivatives(std::declval<const tree_t&>(), std::declval<const C&>())) id_derivatives;
+  decltype(forward_dynamics_derivatives(std::declval<const tree_t&>(), std::declval<const C&>())) fd_derivatives;
+  robot_dynamics_nh(const tree_t& t, const C& k)
+      : c(k),
+        id(inverse_dynamics(t, k)),
+        id_forces(inverse_dynamics_with_forces(t, k)),
+        fd(nh_forward_dynamics(t, k)),
+        lifting(lift(k)),
+        id_derivatives(inverse_dynamics_derivatives(t, k)),
+        fd_derivatives(forward_dynamics_derivatives(t, k)) {}
+};
+template <class V>
+struct robot_dynamics_nh_variant;
+template <class... C>
+struct robot_dynamics_nh_variant<std::variant<C...>> {
+  using type = std::variant<robot_dynamics_nh<C>...>;
+};
+
+inline int index_of(const std::vector<std::string>& names, const std::string& name, const char* what) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it != names.end()) return int(it - names.begin());
+  std::string known;
+  for (const auto& s : names) known += (known.empty() ? "" : ", ") + s;
+  throw model_error(std::string(what) + ": no entry named '" + name + "' (the names: " + known + ")");
+}
+}  // namespace detail
+
+struct robot_dynamics::impl {
+  io::robot_model robot;
+  std::vector<std::string> joints, eta, tau;
+  tree_rne_fn<double> rne;
+  tree_mass_matrix_fn<double> M;
+  tree_bias_fn<double> bias;
+  decltype(nhdyn::forward_dynamics(std::declval<const tree<double>&>())) fd;
+  rne_derivatives_fn<double> rne_derivatives;
+  fd_derivatives_fn<double> fd_derivatives;
+  std::optional<typename detail::robot_dynamics_nh_variant<io::robot_constraint>::type> nh;
+  int p = 0;
+
+  explicit impl(const io::robot_model& r)
+      : robot(r),
+        joints(r.model.joint_names()),
+        eta(r.eta_names()),
+        tau(r.tau_names()),
+        rne(nhdyn::rne(r.model)),
+        M(nhdyn::mass_matrix(r.model)),
+        bias(nhdyn::bias(r.model)),
+        fd(nhdyn::forward_dynamics(r.model)),
+        rne_derivatives(nhdyn::rne_derivatives(r.model)),
+        fd_derivatives(nhdyn::forward_dynamics_derivatives(r.model)),
+        p(int(tau.size())) {
+    if (r.constraint)
+      std::visit([&](const auto& c) { nh.emplace(std::in_place_type<detail::robot_dynamics_nh<std::decay_t<decltype(c)>>>, r.model, c); },
+                 *r.constraint);
+  }
+  /// f(the constraint's function objects), or model_error when the robot has none.
+  template <class F>
+  decltype(auto) on_constraint(const char* what, F&& f) const {
+    if (!nh)
+      throw model_error("robot_dynamics::" + std::string(what) + ": robot '" + robot.name +
+                        "' has no base constraint (its robot file names none); the holonomic calls (rne, "
+                        "forward_dynamics) apply");
+    return std::visit(std::forward<F>(f), *nh);
+  }
+};
+
+NHDYN_COMPILED_INLINE robot_dynamics robot_dynamics::load(const std::string& robot) {
+  return robot_dynamics(io::load_robot(robot));
+}
+NHDYN_COMPILED_INLINE robot_dynamics::robot_dynamics(const io::robot_model& robot)
+    : p_(std::make_shared<const impl>(robot)) {}
+
+NHDYN_COMPILED_INLINE const io::robot_model& robot_dynamics::robot() const { return p_->robot; }
+NHDYN_COMPILED_INLINE const std::string& robot_dynamics::name() const { return p_->robot.name; }
+NHDYN_COMPILED_INLINE int robot_dynamics::dof() const { return int(p_->joints.size()); }
+NHDYN_COMPILED_INLINE int robot_dynamics::m() const { return int(p_->eta.size()); }
+NHDYN_COMPILED_INLINE int robot_dynamics::k() const { return p_->robot.k(); }
+NHDYN_COMPILED_INLINE int robot_dynamics::p() const { return p_->p; }
+NHDYN_COMPILED_INLINE bool robot_dynamics::constrained() const { return p_->nh.has_value(); }
+NHDYN_COMPILED_INLINE const std::vector<std::string>& robot_dynamics::joint_names() const { return p_->joints; }
+NHDYN_COMPILED_INLINE const std::vector<std::string>& robot_dynamics::eta_names() const { return p_->eta; }
+NHDYN_COMPILED_INLINE const std::vector<std::string>& robot_dynamics::tau_names() const { return p_->tau; }
+NHDYN_COMPILED_INLINE int robot_dynamics::joint_index(const std::string& joint) const {
+  return detail::index_of(p_->joints, joint, ("robot '" + p_->robot.name + "', joint_index").c_str());
+}
+NHDYN_COMPILED_INLINE int robot_dynamics::eta_index(const std::string& name) const {
+  return detail::index_of(p_->eta, name, ("robot '" + p_->robot.name + "', eta_index").c_str());
+}
+NHDYN_COMPILED_INLINE int robot_dynamics::tau_index(const std::string& name) const {
+  return detail::index_of(p_->tau, name, ("robot '" + p_->robot.name + "', tau_index").c_str());
+}
+
+NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::rne(vector_arg q, vector_arg qd, vector_arg qdd) const {
+  return p_->rne(q, qd, qdd);
+}
+NHDYN_COMPILED_INLINE void robot_dynamics::rne(vector_arg q, vector_arg qd, vector_arg qdd, Eigen::VectorXd& v) const {
+  v.resize(dof());
+  p_->rne.evaluate(q, qd, qdd, v);
+}
+NHDYN_COMPILED_INLINE Eigen::MatrixXd robot_dynamics::mass_matrix(vector_arg q) const { return p_->M(q); }
+NHDYN_COMPILED_INLINE void robot_dynamics::mass_matrix(vector_arg q, Eigen::MatrixXd& M) const {
+  p_->M.evaluate(q, M);
+}
+NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::bias(vector_arg q, vector_arg qd) const {
+  return p_->bias(q, qd);
+}
+NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::forward_dynamics(vector_arg q, vector_arg qd, vector_arg tau) const {
+  return p_->fd(q, qd, tau);
+}
+NHDYN_COMPILED_INLINE rne_partials robot_dynamics::rne_derivatives(vector_arg q, vector_arg qd, vector_arg qdd) const {
+  auto r = p_->rne_derivatives(q, qd, qdd);
+  return {std::move(r.tau), std::move(r.dq), std::move(r.dqd), std::move(r.M)};
+}
+NHDYN_COMPILED_INLINE forward_partials robot_dynamics::forward_dynamics_derivatives(vector_arg q, vector_arg qd,
+                                                                                    vector_arg tau) const {
+  auto r = p_->fd_derivatives(q, qd, tau);
+  return {std::move(r.qdd), std::move(r.dq), std::move(r.dqd), std::move(r.Minv)};
+}
+
+NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::inverse_dynamics(vector_arg q, vector_arg eta,
+                                                                      vector_arg eta_dot) const {
+  return p_->on_constraint("inverse_dynamics", [&](const auto& x) -> Eigen::VectorXd { return x.id(q, eta, eta_dot); });
+}
+NHDYN_COMPILED_INLINE void robot_dynamics::inverse_dynamics(vector_arg q, vector_arg eta, vector_arg eta_dot,
+                                                            Eigen::VectorXd& tau) const {
+  p_->on_constraint("inverse_dynamics", [&](const auto& x) {
+    tau.resize(p());
+    if constexpr (requires { x.id.evaluate(q, eta, eta_dot, tau); })
+      x.id.evaluate(q, eta, eta_dot, tau);
+    else
+      tau = x.id(q, eta, eta_dot);
+  });
+}
+NHDYN_COMPILED_INLINE robot_forces robot_dynamics::inverse_dynamics_with_forces(vector_arg q, vector_arg eta,
+                                                                                vector_arg eta_dot) const {
+  return p_->on_constraint("inverse_dynamics_with_forces", [&](const auto& x) {
+    auto f = x.id_forces(q, eta, eta_dot);
+    return robot_forces{std::move(f.tau), std::move(f.lambda)};
+  });
+}
+NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::nh_forward_dynamics(vector_arg q, vector_arg eta,
+                                                                         vector_arg tau) const {
+  return p_->on_constraint("nh_forward_dynamics", [&](const auto& x) -> Eigen::VectorXd { return x.fd(q, eta, tau); });
+}
+NHDYN_COMPILED_INLINE robot_state robot_dynamics::lift(vector_arg q, vector_arg eta, vector_arg eta_dot) const {
+  return p_->on_constraint("lift", [&](const auto& x) {
+    auto xi = x.lifting(q, eta, eta_dot);
+    return robot_state{std::move(xi.q), std::move(xi.qd), std::move(xi.qdd)};
+  });
+}
+NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::apply_S(vector_arg q, vector_arg eta) const {
+  return p_->on_constraint("apply_S", [&](const auto& x) -> Eigen::VectorXd {
+    detail::check_size(q, x.c.dof(), "q");
+    detail::check_size(eta, x.c.m(), "eta");
+    detail::check_finite(q, "q");
+    detail::check_finite(eta, "eta");
+    return nhdyn::apply_S(x.c, q, eta);
+  });
+}
+NHDYN_COMPILED_INLINE Eigen::MatrixXd robot_dynamics::S(vector_arg q) const {
+  return p_->on_constraint("S", [&](const auto& x) -> Eigen::MatrixXd {
+    detail::check_size(q, x.c.dof(), "q");
+    detail::check_finite(q, "q");
+    return x.c.S(q);
+  });
+}
+NHDYN_COMPILED_INLINE Eigen::MatrixXd robot_dynamics::A(vector_arg q) const {
+  return p_->on_constraint("A", [&](const auto& x) -> Eigen::MatrixXd {
+    detail::check_size(q, x.c.dof(), "q");
+    detail::check_finite(q, "q");
+    return x.c.A(q);
+  });
+}
+NHDYN_COMPILED_INLINE Eigen::MatrixXd robot_dynamics::input_map(vector_arg q) const {
+  return p_->on_constraint("input_map", [&](const auto& x) -> Eigen::MatrixXd {
+    detail::check_size(q, x.c.dof(), "q");
+    detail::check_finite(q, "q");
+    return nhdyn::input_map(x.c, q);
+  });
+}
+NHDYN_COMPILED_INLINE nh_inverse_partials robot_dynamics::inverse_dynamics_derivatives(vector_arg q, vector_arg eta,
+                                                                                       vector_arg eta_dot) const {
+  return p_->on_constraint("inverse_dynamics_derivatives", [&](const auto& x) {
+    auto r = x.id_derivatives(q, eta, eta_dot);
+    return nh_inverse_partials{std::move(r.tau), std::move(r.dq), std::move(r.deta), std::move(r.deta_dot)};
+  });
+}
+NHDYN_COMPILED_INLINE nh_forward_partials robot_dynamics::nh_forward_dynamics_derivatives(vector_arg q, vector_arg eta,
+                                                                                          vector_arg tau) const {
+  return p_->on_constraint("nh_forward_dynamics_derivatives", [&](const auto& x) {
+    auto r = x.fd_derivatives(q, eta, tau);
+    return nh_forward_partials{std::move(r.eta_dot), std::move(r.ss.A), std::move(r.ss.B)};
+  });
+}
+
+}  // namespace nhdyn
+#endif

@@ -1,0 +1,7 @@
+/// \file src/compiled/dynamics.cpp
+/// nhdyn::compiled (include/nhdyn/config.hpp): robot_dynamics (include/nhdyn/robot_dynamics.hpp),
+/// a loaded robot's double dynamics behind a class without templates, compiled once: every
+/// function object it holds (rne, CRBA, forward dynamics, derivatives, and each built-in base
+/// constraint's inverse and forward dynamics and their derivatives) is instantiated here.
+#define NHDYN_COMPILED_SOURCE 3  // NHDYN_PART_DYNAMICS (include/nhdyn/config.hpp)
+#include <nhdyn/robot_dynamics.hpp>

@@ -1,0 +1,218 @@
+/// robot_dynamics (robot_dynamics.hpp), the front end with no templates, on every shipped robot
+/// file, a URDF without a constraint and the paper's DH model. This program includes only that
+/// header and links nhdyn::compiled where it is built (tests/urdf.cmake), so it tests the
+/// compiled functions. tests/compiled/ shows that header-only gives the same numbers bit for bit.
+/// The checks use physics and a second path, not numbers copied from the code:
+///
+/// - rne = M q̈ + h; forward_dynamics(rne(q̈)) = q̈;
+/// - the derivatives against central differences of the calls they differentiate, and
+///   ∂τ/∂q̈ = M, ∂q̈/∂τ · M = I;
+/// - A S = 0; lift's q̇ = S η = apply_S; the lifted v = E τ + Aᵀλ (the split of the generalized
+///   force); nh_forward_dynamics(inverse_dynamics(η̇)) = η̇;
+/// - the top-right block of the state-space A is S (∂(Sη)/∂η), and B against differences;
+/// - the call and the form into storage give the same τ bit for bit, and so do
+///   inverse_dynamics and inverse_dynamics_with_forces; two threads give the same numbers as one;
+/// - the errors: wrong sizes, NaN, a nonholonomic call without a constraint, unknown names and
+///   files, each naming what is wrong.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nhdyn/robot_dynamics.hpp>
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+namespace {
+
+std::string source(const std::string& rel) { return std::string(NHDYN_SOURCE_DIR) + "/" + rel; }
+
+std::vector<std::string> shipped_robot_files() {
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(source("examples/robots")))
+    if (e.path().extension() == ".json") files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+VectorXd wave(int n, double a, double b, double c) {
+  VectorXd x(n);
+  for (int i = 0; i < n; ++i) x(i) = a * std::sin(b * i + c);
+  return x;
+}
+
+/// Central differences of f (a vector of x) at x, column by column. h = 1e-4: the truncation
+/// error (h²) stays near 1e-8, and the rounding error stays small where M is ill-conditioned
+/// (tiago_style: cond(M) = 1e9, so that h = 1e-6 gives 3e-5 from rounding alone).
+template <class F>
+MatrixXd differences(const F& f, const VectorXd& x, double h = 1e-4) {
+  const VectorXd f0 = f(x);
+  MatrixXd J(f0.size(), x.size());
+  for (int j = 0; j < x.size(); ++j) {
+    VectorXd xp = x, xm = x;
+    xp(j) += h, xm(j) -= h;
+    J.col(j) = (f(xp) - f(xm)) / (2 * h);
+  }
+  return J;
+}
+
+double rel(const MatrixXd& a, const MatrixXd& b) { return (a - b).norm() / (1 + b.norm()); }
+
+/// The holonomic calls' checks on robot r at a state of its size.
+void check_holonomic(const nhdyn::robot_dynamics& r) {
+  const int n = r.dof();
+  const VectorXd q = wave(n, 0.8, 0.7, 0.3), qd = wave(n, 1.1, 1.3, 0.1), qdd = wave(n, 0.9, 0.4, 1.7);
+  const VectorXd v = r.rne(q, qd, qdd);
+  const MatrixXd M = r.mass_matrix(q);
+  const VectorXd h = r.bias(q, qd);
+  CHECK(rel(M * qdd + h, v) < 1e-12);
+  CHECK(rel(M, M.transpose()) == 0.0);
+  CHECK(rel(r.forward_dynamics(q, qd, v), qdd) < 1e-9);
+  VectorXd into;
+  r.rne(q, qd, qdd, into);
+  CHECK(into == v);
+  MatrixXd M_into;
+  r.mass_matrix(q, M_into);
+  CHECK(M_into == M);
+
+  const auto d = r.rne_derivatives(q, qd, qdd);
+  CHECK(rel(d.tau, v) < 1e-13);
+  CHECK(rel(d.M, M) < 1e-13);
+  CHECK(rel(d.dq, differences([&](const VectorXd& x) { return r.rne(x, qd, qdd); }, q)) < 1e-7);
+  CHECK(rel(d.dqd, differences([&](const VectorXd& x) { return r.rne(q, x, qdd); }, qd)) < 1e-7);
+
+  const VectorXd tau = wave(n, 2.0, 0.5, 0.2);
+  const auto f = r.forward_dynamics_derivatives(q, qd, tau);
+  CHECK(rel(f.qdd, r.forward_dynamics(q, qd, tau)) < 1e-12);
+  CHECK(rel(f.Minv * M, MatrixXd::Identity(n, n)) < 1e-9);
+  CHECK(rel(f.dq, differences([&](const VectorXd& x) { return r.forward_dynamics(x, qd, tau); }, q)) < 1e-6);
+  CHECK(rel(f.dqd, differences([&](const VectorXd& x) { return r.forward_dynamics(q, x, tau); }, qd)) < 1e-6);
+}
+
+/// The nonholonomic calls' checks.
+void check_constrained(const nhdyn::robot_dynamics& r) {
+  const int n = r.dof(), m = r.m(), p = r.p();
+  REQUIRE(r.constrained());
+  REQUIRE(int(r.eta_names().size()) == m);
+  REQUIRE(int(r.tau_names().size()) == p);
+  // the base's yaw away from 0 and joints away from their zero (a castor's steering too)
+  const VectorXd q = wave(n, 0.6, 0.9, 0.4), eta = wave(m, 0.7, 1.1, 0.5), eta_dot = wave(m, 0.5, 0.6, 1.2);
+  const MatrixXd S = r.S(q), A = r.A(q), E = r.input_map(q);
+  REQUIRE(S.rows() == n);
+  REQUIRE(S.cols() == m);
+  REQUIRE(A.rows() == r.k());
+  REQUIRE(E.cols() == p);
+  CHECK((A * S).norm() < 1e-12 * (1 + A.norm() * S.norm()));
+  CHECK(rel(r.apply_S(q, eta), S * eta) < 1e-14);
+
+  const auto xi = r.lift(q, eta, eta_dot);
+  CHECK(xi.q == q);
+  CHECK(rel(xi.qd, S * eta) < 1e-14);
+  // q̈ = S η̇ + Ṡ η: Ṡ η by a central difference of S along q̇ = S η
+  const double eps = 1e-6;
+  const MatrixXd Sdot = (r.S(q + eps * xi.qd) - r.S(q - eps * xi.qd)) / (2 * eps);
+  CHECK(rel(xi.qdd, S * eta_dot + Sdot * eta) < 1e-7);
+
+  const VectorXd tau = r.inverse_dynamics(q, eta, eta_dot);
+  const auto f = r.inverse_dynamics_with_forces(q, eta, eta_dot);
+  CHECK(f.tau == tau);
+  REQUIRE(f.lambda.size() == r.k());
+  VectorXd into = VectorXd::Constant(3, 99.0);  // another size: resized
+  r.inverse_dynamics(q, eta, eta_dot, into);
+  CHECK(into == tau);
+  const VectorXd v = r.rne(xi.q, xi.qd, xi.qdd);
+  CHECK(rel(E * f.tau + A.transpose() * f.lambda, v) < 1e-10);
+  CHECK(rel(r.nh_forward_dynamics(q, eta, tau), eta_dot) < 1e-9);
+
+  const auto d = r.inverse_dynamics_derivatives(q, eta, eta_dot);
+  CHECK(rel(d.tau, tau) < 1e-12);
+  CHECK(rel(d.dq, differences([&](const VectorXd& x) { return r.inverse_dynamics(x, eta, eta_dot); }, q)) < 1e-6);
+  CHECK(rel(d.deta, differences([&](const VectorXd& x) { return r.inverse_dynamics(q, x, eta_dot); }, eta)) < 1e-6);
+  CHECK(rel(d.deta_dot, differences([&](const VectorXd& x) { return r.inverse_dynamics(q, eta, x); }, eta_dot)) <
+        1e-6);
+
+  const VectorXd u = tau + wave(p, 0.3, 0.8, 0.9);
+  const auto g = r.nh_forward_dynamics_derivatives(q, eta, u);
+  CHECK(rel(g.eta_dot, r.nh_forward_dynamics(q, eta, u)) < 1e-12);
+  REQUIRE(g.A.rows() == n + m);
+  REQUIRE(g.B.cols() == p);
+  CHECK(rel(g.A.block(0, n, n, m), S) < 1e-14);  // ∂(Sη)/∂η
+  CHECK(rel(g.B.bottomRows(m), differences([&](const VectorXd& x) { return r.nh_forward_dynamics(q, eta, x); }, u)) <
+        1e-6);
+  CHECK(rel(g.A.bottomLeftCorner(m, n),
+            differences([&](const VectorXd& x) { return r.nh_forward_dynamics(x, eta, u); }, q)) < 1e-6);
+}
+
+}  // namespace
+
+TEST_CASE("robot_dynamics: every shipped robot file, holonomic and on its constraint") {
+  const auto files = shipped_robot_files();
+  REQUIRE(files.size() >= 10);
+  int constrained = 0;
+  for (const auto& file : files) {
+    INFO(file);
+    const auto r = nhdyn::robot_dynamics::load(file);
+    REQUIRE(int(r.joint_names().size()) == r.dof());
+    check_holonomic(r);
+    if (r.constrained()) {
+      ++constrained;
+      check_constrained(r);
+    }
+  }
+  CHECK(constrained == int(files.size()));  // every shipped robot file names its base constraint
+}
+
+TEST_CASE("robot_dynamics: a URDF (no constraint) and the paper's DH model as its tree") {
+  const auto urdf = nhdyn::robot_dynamics::load(source("examples/urdf/mobile_manipulator.urdf"));
+  CHECK_FALSE(urdf.constrained());
+  CHECK(urdf.k() == 0);
+  CHECK(urdf.m() == urdf.dof());
+  check_holonomic(urdf);
+  const VectorXd z = VectorXd::Zero(urdf.dof());
+  CHECK_THROWS_WITH(urdf.inverse_dynamics(z, z, z), Catch::Contains("no base constraint") && Catch::Contains("inverse_dynamics"));
+  CHECK_THROWS_AS(urdf.S(z), nhdyn::model_error);
+
+  const auto paper5 = nhdyn::robot_dynamics::load("paper5");
+  CHECK(paper5.constrained());
+  CHECK(paper5.k() == 1);
+  check_holonomic(paper5);
+  check_constrained(paper5);
+}
+
+TEST_CASE("robot_dynamics: bad input is named") {
+  const auto r = nhdyn::robot_dynamics::load(source("examples/robots/mobile_manipulator_wheels.json"));
+  const int n = r.dof(), m = r.m();
+  const VectorXd q = VectorXd::Zero(n), e = VectorXd::Zero(m);
+  CHECK_THROWS_WITH(r.rne(VectorXd::Zero(n + 1), q, q), Catch::Contains("q"));
+  CHECK_THROWS_AS(r.rne(VectorXd::Zero(n + 1), q, q), nhdyn::error);
+  VectorXd bad = q;
+  bad(2) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_WITH(r.rne(q, bad, q), Catch::Contains("qd"));
+  CHECK_THROWS_WITH(r.inverse_dynamics(q, VectorXd::Zero(m + 2), e), Catch::Contains("eta"));
+  CHECK_THROWS_WITH(r.apply_S(q, VectorXd::Zero(m - 1)), Catch::Contains("eta"));
+  CHECK_THROWS_WITH(r.A(bad), Catch::Contains("q"));
+  CHECK_THROWS_WITH(r.eta_index("no_such_joint"), Catch::Contains("no_such_joint") && Catch::Contains("arm_1_joint"));
+  CHECK_THROWS_AS(nhdyn::robot_dynamics::load(source("examples/robots/no_such_file.json")), nhdyn::error);
+}
+
+TEST_CASE("robot_dynamics: copies share one model; two threads give one thread's numbers") {
+  const auto r = nhdyn::robot_dynamics::load(source("examples/robots/mecanum_arm.json"));
+  const auto copy = r;
+  CHECK(&copy.robot() == &r.robot());
+  const int n = r.dof(), m = r.m();
+  std::vector<VectorXd> alone(200), a(200), b(200);
+  for (int i = 0; i < 200; ++i) alone[std::size_t(i)] = r.inverse_dynamics(wave(n, 0.5, 0.3, 0.01 * i), wave(m, 1, 0.2, i), wave(m, 1, 0.5, i));
+  const auto work = [&](std::vector<VectorXd>& out) {
+    for (int i = 0; i < 200; ++i) out[std::size_t(i)] = copy.inverse_dynamics(wave(n, 0.5, 0.3, 0.01 * i), wave(m, 1, 0.2, i), wave(m, 1, 0.5, i));
+  };
+  std::thread t1(work, std::ref(a)), t2(work, std::ref(b));
+  t1.join(), t2.join();
+  CHECK(a == alone);
+  CHECK(b == alone);
+}
