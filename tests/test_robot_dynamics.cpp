@@ -11,9 +11,10 @@
 ///   force); nh_forward_dynamics(inverse_dynamics(η̇)) = η̇;
 /// - the top-right block of the state-space A is S (∂(Sη)/∂η), and B against differences;
 /// - the call and the form into storage give the same τ bit for bit, and so do
-///   inverse_dynamics and inverse_dynamics_with_forces; two threads give the same numbers as one;
+///   inverse_dynamics and inverse_dynamics_with_forces; two threads running every call with
+///   scratch of its own (the derivatives) give the same numbers as one;
 /// - the errors: wrong sizes, NaN, a nonholonomic call without a constraint, unknown names and
-///   files, each naming what is wrong.
+///   files, each naming the robot, the call and what is wrong; the names and their indices.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -185,34 +186,75 @@ TEST_CASE("robot_dynamics: a URDF (no constraint) and the paper's DH model as it
   check_constrained(paper5);
 }
 
-TEST_CASE("robot_dynamics: bad input is named") {
+TEST_CASE("robot_dynamics: bad input is named, with the robot and the call") {
   const auto r = nhdyn::robot_dynamics::load(source("examples/robots/mobile_manipulator_wheels.json"));
   const int n = r.dof(), m = r.m();
   const VectorXd q = VectorXd::Zero(n), e = VectorXd::Zero(m);
-  CHECK_THROWS_WITH(r.rne(VectorXd::Zero(n + 1), q, q), Catch::Contains("q"));
-  CHECK_THROWS_AS(r.rne(VectorXd::Zero(n + 1), q, q), nhdyn::error);
+  const std::string robot = "robot '" + r.name() + "', ";
+  CHECK_THROWS_WITH(r.rne(VectorXd::Zero(n + 1), q, q),
+                    robot + "rne: q has " + std::to_string(n + 1) + " entries; the model needs " + std::to_string(n));
+  CHECK_THROWS_AS(r.rne(VectorXd::Zero(n + 1), q, q), nhdyn::input_error);
   VectorXd bad = q;
   bad(2) = std::numeric_limits<double>::quiet_NaN();
-  CHECK_THROWS_WITH(r.rne(q, bad, q), Catch::Contains("qd"));
-  CHECK_THROWS_WITH(r.inverse_dynamics(q, VectorXd::Zero(m + 2), e), Catch::Contains("eta"));
-  CHECK_THROWS_WITH(r.apply_S(q, VectorXd::Zero(m - 1)), Catch::Contains("eta"));
-  CHECK_THROWS_WITH(r.A(bad), Catch::Contains("q"));
-  CHECK_THROWS_WITH(r.eta_index("no_such_joint"), Catch::Contains("no_such_joint") && Catch::Contains("arm_1_joint"));
+  CHECK_THROWS_WITH(r.rne(q, bad, q), Catch::StartsWith(robot + "rne: qd[2] is not finite"));
+  CHECK_THROWS_WITH(r.mass_matrix(VectorXd::Zero(2)), Catch::StartsWith(robot + "mass_matrix: q has 2 entries"));
+  CHECK_THROWS_WITH(r.inverse_dynamics(q, VectorXd::Zero(m + 2), e), Catch::StartsWith(robot + "inverse_dynamics: eta has "));
+  CHECK_THROWS_WITH(r.inverse_dynamics(q, e, VectorXd::Zero(1)), Catch::StartsWith(robot + "inverse_dynamics: eta_dot has 1 "));
+  CHECK_THROWS_WITH(r.apply_S(q, VectorXd::Zero(m - 1)), Catch::StartsWith(robot + "apply_S: eta has "));
+  CHECK_THROWS_WITH(r.A(bad), Catch::StartsWith(robot + "A: q[2] is not finite"));
+  CHECK_THROWS_WITH(r.nh_forward_dynamics_derivatives(q, e, VectorXd::Zero(r.p() + 1)),
+                    Catch::StartsWith(robot + "nh_forward_dynamics_derivatives: tau has "));
+  CHECK_THROWS_WITH(r.eta_index("no_such_joint"),
+                    Catch::StartsWith(robot + "eta_index: no entry named 'no_such_joint'") && Catch::Contains("arm_1_joint"));
   CHECK_THROWS_AS(nhdyn::robot_dynamics::load(source("examples/robots/no_such_file.json")), nhdyn::error);
+}
+
+TEST_CASE("robot_dynamics: names and their indices") {
+  const auto r = nhdyn::robot_dynamics::load(source("examples/robots/mecanum_arm.json"));
+  CHECK(r.name() == "mecanum_arm");
+  REQUIRE(r.p() == r.m() + 1);  // four wheels drive the base's three velocities: τ ≠ η's names
+  for (int i = 0; i < r.dof(); ++i) CHECK(r.joint_index(r.joint_names()[std::size_t(i)]) == i);
+  for (int i = 0; i < r.m(); ++i) CHECK(r.eta_index(r.eta_names()[std::size_t(i)]) == i);
+  for (int i = 0; i < r.p(); ++i) CHECK(r.tau_index(r.tau_names()[std::size_t(i)]) == i);
+  CHECK(r.joint_names()[0] == "base_x");
+  // every actuated joint is a joint, and the call's τ has their number of entries
+  for (const auto& name : r.tau_names()) CHECK_NOTHROW(r.joint_index(name));
+  const VectorXd q = wave(r.dof(), 0.3, 0.5, 0.1), eta = wave(r.m(), 0.4, 0.9, 0.2);
+  CHECK(r.inverse_dynamics(q, eta, eta).size() == r.p());
 }
 
 TEST_CASE("robot_dynamics: copies share one model; two threads give one thread's numbers") {
   const auto r = nhdyn::robot_dynamics::load(source("examples/robots/mecanum_arm.json"));
-  const auto copy = r;
+  auto copy = r;
   CHECK(&copy.robot() == &r.robot());
-  const int n = r.dof(), m = r.m();
-  std::vector<VectorXd> alone(200), a(200), b(200);
-  for (int i = 0; i < 200; ++i) alone[std::size_t(i)] = r.inverse_dynamics(wave(n, 0.5, 0.3, 0.01 * i), wave(m, 1, 0.2, i), wave(m, 1, 0.5, i));
-  const auto work = [&](std::vector<VectorXd>& out) {
-    for (int i = 0; i < 200; ++i) out[std::size_t(i)] = copy.inverse_dynamics(wave(n, 0.5, 0.3, 0.01 * i), wave(m, 1, 0.2, i), wave(m, 1, 0.5, i));
+  auto moved = std::move(copy);  // a copy: no robot_dynamics is ever empty
+  CHECK(&moved.robot() == &r.robot());
+  CHECK(copy.dof() == r.dof());
+  const int n = r.dof(), m = r.m(), p = r.p();
+  constexpr int K = 60;
+  // every call with scratch of its own (the derivatives keep theirs per thread) at K states
+  const auto run = [&](const nhdyn::robot_dynamics& x, std::vector<VectorXd>& out) {
+    out.clear();
+    for (int i = 0; i < K; ++i) {
+      const VectorXd q = wave(n, 0.5, 0.3, 0.01 * i), e = wave(m, 1, 0.2, i), ed = wave(m, 1, 0.5, i);
+      const VectorXd tau = x.inverse_dynamics(q, e, ed);
+      out.push_back(tau);
+      out.push_back(x.nh_forward_dynamics(q, e, tau + wave(p, 0.1, 0.4, i)));
+      const auto d = x.inverse_dynamics_derivatives(q, e, ed);
+      out.push_back(Eigen::Map<const VectorXd>(d.dq.data(), d.dq.size()));
+      const auto g = x.nh_forward_dynamics_derivatives(q, e, tau);
+      out.push_back(Eigen::Map<const VectorXd>(g.A.data(), g.A.size()));
+      const auto h = x.rne_derivatives(q, wave(n, 1, 0.7, i), wave(n, 1, 0.3, i));
+      out.push_back(Eigen::Map<const VectorXd>(h.dq.data(), h.dq.size()));
+      const auto f = x.forward_dynamics_derivatives(q, wave(n, 1, 0.7, i), wave(n, 1, 0.3, i));
+      out.push_back(Eigen::Map<const VectorXd>(f.dqd.data(), f.dqd.size()));
+    }
   };
-  std::thread t1(work, std::ref(a)), t2(work, std::ref(b));
+  std::vector<VectorXd> alone, a, b;
+  run(r, alone);
+  std::thread t1(run, std::cref(r), std::ref(a)), t2(run, std::cref(moved), std::ref(b));
   t1.join(), t2.join();
+  REQUIRE(alone.size() == std::size_t(6 * K));
   CHECK(a == alone);
   CHECK(b == alone);
 }

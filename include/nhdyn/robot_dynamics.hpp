@@ -22,8 +22,10 @@
 /// wrenches and user constraints need the template API (nhdyn.hpp); `robot()` gives the loaded
 /// robot for it. Every call checks its arguments' sizes and finiteness, and throws nhdyn::error
 /// (errors.hpp) naming the argument. A nonholonomic call on a robot without a constraint throws
-/// model_error. A robot_dynamics is immutable: copies share one model, and concurrent calls
-/// from several threads are safe.
+/// model_error; every error's message begins with the robot's name and the call. A
+/// robot_dynamics is immutable: copies share one model, and concurrent calls from several
+/// threads are safe. An output argument (the forms that write into storage) must not be one of
+/// the same call's inputs.
 #include <memory>
 #include <string>
 #include <vector>
@@ -80,6 +82,10 @@ class robot_dynamics {
   NHDYN_COMPILED_INLINE static robot_dynamics load(const std::string& robot);
   /// A robot already loaded (io::load_robot_file, io::as_robot, io::lock_robot).
   NHDYN_COMPILED_INLINE explicit robot_dynamics(const io::robot_model& robot);
+  /// Copies share the one immutable model. There is no move: a "move" copies the shared
+  /// pointer, so that no robot_dynamics is ever empty.
+  robot_dynamics(const robot_dynamics&) = default;
+  robot_dynamics& operator=(const robot_dynamics&) = default;
 
   /// The loaded robot: its tree and its constraint, for the template API (io/robot_file.hpp).
   NHDYN_COMPILED_INLINE const io::robot_model& robot() const;
@@ -189,12 +195,14 @@ struct robot_dynamics_nh_variant<std::variant<C...>> {
   using type = std::variant<robot_dynamics_nh<C>...>;
 };
 
-inline int index_of(const std::vector<std::string>& names, const std::string& name, const char* what) {
+/// The index of `name` in `names`; model_error naming the robot, the call and the names there are.
+inline int index_of(const std::vector<std::string>& names, const std::string& name, const std::string& robot,
+                    const char* what) {
   const auto it = std::find(names.begin(), names.end(), name);
   if (it != names.end()) return int(it - names.begin());
   std::string known;
   for (const auto& s : names) known += (known.empty() ? "" : ", ") + s;
-  throw model_error(std::string(what) + ": no entry named '" + name + "' (the names: " + known + ")");
+  throw model_error("robot '" + robot + "', " + what + ": no entry named '" + name + "' (the names: " + known + ")");
 }
 }  // namespace detail
 
@@ -226,14 +234,28 @@ struct robot_dynamics::impl {
       std::visit([&](const auto& c) { nh.emplace(std::in_place_type<detail::robot_dynamics_nh<std::decay_t<decltype(c)>>>, r.model, c); },
                  *r.constraint);
   }
-  /// f(the constraint's function objects), or model_error when the robot has none.
+  /// "robot 'NAME', CALL: ", the beginning of every message of a call.
+  std::string where(const char* what) const { return "robot '" + robot.name + "', " + what + ": "; }
+  /// f(), its errors' messages begun by where(what) (the same exception types).
+  template <class F>
+  decltype(auto) guarded(const char* what, F&& f) const {
+    try {
+      return f();
+    } catch (const input_error& e) {
+      throw input_error(where(what) + e.what());
+    } catch (const numerical_error& e) {
+      throw numerical_error(where(what) + e.what());
+    } catch (const model_error& e) {
+      throw model_error(where(what) + e.what());
+    }
+  }
+  /// f(the constraint's function objects), guarded; model_error when the robot has none.
   template <class F>
   decltype(auto) on_constraint(const char* what, F&& f) const {
     if (!nh)
-      throw model_error("robot_dynamics::" + std::string(what) + ": robot '" + robot.name +
-                        "' has no base constraint (its robot file names none); the holonomic calls (rne, "
-                        "forward_dynamics) apply");
-    return std::visit(std::forward<F>(f), *nh);
+      throw model_error(where(what) + "the robot has no base constraint (it was loaded without one); the holonomic "
+                                      "calls (rne, mass_matrix, forward_dynamics, ...) apply");
+    return guarded(what, [&]() -> decltype(auto) { return std::visit(f, *nh); });
   }
 };
 
@@ -254,40 +276,48 @@ NHDYN_COMPILED_INLINE const std::vector<std::string>& robot_dynamics::joint_name
 NHDYN_COMPILED_INLINE const std::vector<std::string>& robot_dynamics::eta_names() const { return p_->eta; }
 NHDYN_COMPILED_INLINE const std::vector<std::string>& robot_dynamics::tau_names() const { return p_->tau; }
 NHDYN_COMPILED_INLINE int robot_dynamics::joint_index(const std::string& joint) const {
-  return detail::index_of(p_->joints, joint, ("robot '" + p_->robot.name + "', joint_index").c_str());
+  return detail::index_of(p_->joints, joint, p_->robot.name, "joint_index");
 }
 NHDYN_COMPILED_INLINE int robot_dynamics::eta_index(const std::string& name) const {
-  return detail::index_of(p_->eta, name, ("robot '" + p_->robot.name + "', eta_index").c_str());
+  return detail::index_of(p_->eta, name, p_->robot.name, "eta_index");
 }
 NHDYN_COMPILED_INLINE int robot_dynamics::tau_index(const std::string& name) const {
-  return detail::index_of(p_->tau, name, ("robot '" + p_->robot.name + "', tau_index").c_str());
+  return detail::index_of(p_->tau, name, p_->robot.name, "tau_index");
 }
 
 NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::rne(vector_arg q, vector_arg qd, vector_arg qdd) const {
-  return p_->rne(q, qd, qdd);
+  return p_->guarded("rne", [&] { return Eigen::VectorXd(p_->rne(q, qd, qdd)); });
 }
 NHDYN_COMPILED_INLINE void robot_dynamics::rne(vector_arg q, vector_arg qd, vector_arg qdd, Eigen::VectorXd& v) const {
-  v.resize(dof());
-  p_->rne.evaluate(q, qd, qdd, v);
+  p_->guarded("rne", [&] {
+    v.resize(dof());
+    p_->rne.evaluate(q, qd, qdd, v);
+  });
 }
-NHDYN_COMPILED_INLINE Eigen::MatrixXd robot_dynamics::mass_matrix(vector_arg q) const { return p_->M(q); }
+NHDYN_COMPILED_INLINE Eigen::MatrixXd robot_dynamics::mass_matrix(vector_arg q) const {
+  return p_->guarded("mass_matrix", [&] { return Eigen::MatrixXd(p_->M(q)); });
+}
 NHDYN_COMPILED_INLINE void robot_dynamics::mass_matrix(vector_arg q, Eigen::MatrixXd& M) const {
-  p_->M.evaluate(q, M);
+  p_->guarded("mass_matrix", [&] { p_->M.evaluate(q, M); });
 }
 NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::bias(vector_arg q, vector_arg qd) const {
-  return p_->bias(q, qd);
+  return p_->guarded("bias", [&] { return Eigen::VectorXd(p_->bias(q, qd)); });
 }
 NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::forward_dynamics(vector_arg q, vector_arg qd, vector_arg tau) const {
-  return p_->fd(q, qd, tau);
+  return p_->guarded("forward_dynamics", [&] { return Eigen::VectorXd(p_->fd(q, qd, tau)); });
 }
 NHDYN_COMPILED_INLINE rne_partials robot_dynamics::rne_derivatives(vector_arg q, vector_arg qd, vector_arg qdd) const {
-  auto r = p_->rne_derivatives(q, qd, qdd);
-  return {std::move(r.tau), std::move(r.dq), std::move(r.dqd), std::move(r.M)};
+  return p_->guarded("rne_derivatives", [&] {
+    auto r = p_->rne_derivatives(q, qd, qdd);
+    return rne_partials{std::move(r.tau), std::move(r.dq), std::move(r.dqd), std::move(r.M)};
+  });
 }
 NHDYN_COMPILED_INLINE forward_partials robot_dynamics::forward_dynamics_derivatives(vector_arg q, vector_arg qd,
                                                                                     vector_arg tau) const {
-  auto r = p_->fd_derivatives(q, qd, tau);
-  return {std::move(r.qdd), std::move(r.dq), std::move(r.dqd), std::move(r.Minv)};
+  return p_->guarded("forward_dynamics_derivatives", [&] {
+    auto r = p_->fd_derivatives(q, qd, tau);
+    return forward_partials{std::move(r.qdd), std::move(r.dq), std::move(r.dqd), std::move(r.Minv)};
+  });
 }
 
 NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::inverse_dynamics(vector_arg q, vector_arg eta,
