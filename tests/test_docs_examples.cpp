@@ -237,7 +237,7 @@ TEST_CASE("docs/api.md §11: robot_dynamics gives the template API's numbers, an
   // a preset, a URDF, a robot file or a JSON model; robot.dof() = n, m(), k(), p(), the names
   const Eigen::VectorXd tau = robot.inverse_dynamics(q, eta, eta_dot);  // project ∘ rne ∘ lift
   const auto f = robot.inverse_dynamics_with_forces(q, eta, eta_dot);   // f.tau, f.lambda
-  const Eigen::VectorXd eta_ddot = robot.nh_forward_dynamics(q, eta, f.tau);  // = eta_dot
+  const Eigen::VectorXd eta_dot_back = robot.nh_forward_dynamics(q, eta, f.tau);  // = eta_dot
   const auto xi = robot.lift(q, eta, eta_dot);                           // xi.q, xi.qd, xi.qdd
   const Eigen::VectorXd v = robot.rne(xi.q, xi.qd, xi.qdd);              // = E τ + Aᵀλ
   const Eigen::MatrixXd M = robot.mass_matrix(q), E = robot.input_map(q), A = robot.A(q);
@@ -250,7 +250,7 @@ TEST_CASE("docs/api.md §11: robot_dynamics gives the template API's numbers, an
   CHECK(robot.p() == 9);
   CHECK(tau_reused == tau);
   CHECK(f.tau == tau);
-  CHECK(rel(eta_ddot, eta_dot) < 1e-9);
+  CHECK(rel(eta_dot_back, eta_dot) < 1e-9);
   CHECK(rel(E * f.tau + A.transpose() * f.lambda, v) < 1e-10);
   CHECK(relm(M, M.transpose()) < 1e-15);
   CHECK(lin.A.rows() == 20);
