@@ -9,7 +9,7 @@
 /// Checks its own answer and exits 1 when wrong: the forward dynamics must give back η̇, and
 /// the generalized force must split exactly into actuators and constraint: v = Eτ + Aᵀλ.
 ///
-/// It uses robot_dynamics (robot_dynamics.hpp), the front end with no templates: linked with
+/// It uses robot_dynamics (robot_dynamics.hpp), the front end compiled in the library: linked with
 /// nhdyn::compiled, this file compiles in seconds (docs/performance.md, "Compile times").
 #include <cmath>
 #include <cstdio>

@@ -1,4 +1,4 @@
-/// robot_dynamics (robot_dynamics.hpp), the front end with no templates, on every shipped robot
+/// robot_dynamics (robot_dynamics.hpp), the front end compiled in the library, on every shipped robot
 /// file, a URDF without a constraint and the paper's DH model. This program includes only that
 /// header and links nhdyn::compiled where it is built (tests/urdf.cmake), so it tests the
 /// compiled functions. tests/compiled/ shows that header-only gives the same numbers bit for bit.
@@ -20,10 +20,13 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <unistd.h>
 
 #include <nhdyn/robot_dynamics.hpp>
 
@@ -207,6 +210,26 @@ TEST_CASE("robot_dynamics: bad input is named, with the robot and the call") {
   CHECK_THROWS_WITH(r.eta_index("no_such_joint"),
                     Catch::StartsWith(robot + "eta_index: no entry named 'no_such_joint'") && Catch::Contains("arm_1_joint"));
   CHECK_THROWS_AS(nhdyn::robot_dynamics::load(source("examples/robots/no_such_file.json")), nhdyn::error);
+}
+
+TEST_CASE("robot_dynamics: a JSON file that is neither a robot file nor a model is named as such") {
+  const auto dir = std::filesystem::temp_directory_path() / ("nhdyn_rd_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& name, const std::string& text) {
+    const std::string path = (dir / name).string();
+    std::ofstream(path) << text;
+    return path;
+  };
+  // a robot file whose "urdf" key is misspelt: not the DH parser's complaint about its keys
+  const auto typo = write("typo.json", R"({"name": "r", "urdff": "robot.urdf", "base": {"type": "planar"}})");
+  CHECK_THROWS_WITH(nhdyn::robot_dynamics::load(typo),
+                    "robot '" + typo + "': a JSON object that is neither a robot file (it needs \"urdf\", "
+                    "docs/model-format.md) nor a DH model file (it needs \"links\"); its keys: 'base', 'name', 'urdff'");
+  CHECK_THROWS_AS(nhdyn::robot_dynamics::load(typo), nhdyn::model_error);
+  // not JSON at all: the error names the file and the line
+  const auto broken = write("broken.json", "{\n  \"name\": \"r\",\n  \"urdf\" \"robot.urdf\"\n}\n");
+  CHECK_THROWS_WITH(nhdyn::robot_dynamics::load(broken), Catch::Contains(broken) && Catch::Contains("line 3"));
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("robot_dynamics: names and their indices") {

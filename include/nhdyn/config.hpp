@@ -7,13 +7,17 @@
 /// that a program that links it does not compile them again in every file that includes them
 /// (docs/install.md lists them).
 ///
-/// - Header-only (nothing defined): every function is defined in its header, `inline`.
+/// - Header-only (nothing defined): every function is defined in its header. A compiled
+///   function is a function template with one defaulted, unused parameter
+///   (`template <class = void>`; robot_dynamics is the class template basic_robot_dynamics), so
+///   that header-only its body is compiled only in the files that call it, not in every file
+///   that includes its header.
 /// - `NHDYN_COMPILED` (set by linking `nhdyn::compiled`): the headers declare the compiled
 ///   functions and leave out their definitions (and the urdfdom and tinyxml2 headers they
-///   need); the program links them from the library.
+///   need); the program links them from the library, which instantiates each once
+///   (src/compiled/).
 /// - `NHDYN_COMPILED_SOURCE` = a part (the library's own sources, src/compiled/, one per
-///   part): the headers define that part's compiled functions once, not inline, and declare
-///   the other parts'.
+///   part): the headers define that part's compiled functions and declare the other parts'.
 ///
 /// The same definitions are compiled either way, from the same headers: a program gives the
 /// same numbers bit for bit header-only or compiled (tests/compiled/).
@@ -25,16 +29,13 @@
 
 /// NHDYN_DEFINES(part): whether this translation unit defines the part's compiled functions.
 #if defined(NHDYN_COMPILED_SOURCE)
-/// The library's source file of part NHDYN_COMPILED_SOURCE: that part's definitions, external;
-/// the other parts declared only (another source file defines them).
+/// The library's source file of part NHDYN_COMPILED_SOURCE: that part's definitions; the other
+/// parts declared only (another source file defines them).
 #define NHDYN_DEFINES(part) (NHDYN_COMPILED_SOURCE == (part))
-#define NHDYN_COMPILED_INLINE
 #elif defined(NHDYN_COMPILED)
 /// A program linking nhdyn::compiled: the compiled functions are declared only.
 #define NHDYN_DEFINES(part) 0
-#define NHDYN_COMPILED_INLINE
 #else
-/// Header-only: the compiled functions are defined here, inline.
+/// Header-only: the compiled functions are defined here.
 #define NHDYN_DEFINES(part) 1
-#define NHDYN_COMPILED_INLINE inline
 #endif

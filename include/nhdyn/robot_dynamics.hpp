@@ -1,8 +1,9 @@
 #pragma once
 /// \file robot_dynamics.hpp
-/// `robot_dynamics`: a loaded robot's dynamics in double behind an interface with no templates.
-/// It is the fast-to-compile front end (issue 33 item 4). The function objects (rne, inverse_dynamics,
-/// …) are the library; this class calls them and adds nothing to their numbers.
+/// `robot_dynamics`: a loaded robot's dynamics in double behind an interface with nothing to
+/// instantiate. It is the fast-to-compile front end (issue 33 item 4). The function objects
+/// (rne, inverse_dynamics, …) are the library; this class calls them and adds nothing to their
+/// numbers.
 ///
 ///     auto robot = nhdyn::robot_dynamics::load("my_robot.json");  // a robot file, URDF, JSON model or preset
 ///     Eigen::VectorXd tau = robot.inverse_dynamics(q, eta, eta_dot);  // project ∘ rne ∘ lift
@@ -13,8 +14,9 @@
 /// tens of seconds (docs/performance.md, "Compile times").
 ///
 /// Header-only (no nhdyn::compiled): this header includes the library and defines the class
-/// inline, from the same code. The same program gives the same numbers bit for bit either way
-/// (tests/compiled/).
+/// from the same code, a template (`basic_robot_dynamics<double>`) so that its bodies are
+/// compiled only in the files that use it. The same program gives the same numbers bit for bit
+/// either way (tests/compiled/).
 ///
 /// Coverage: trees with any built-in base constraint (io::robot_constraint) or none. A DH model
 /// (a JSON model file, a preset) runs as its tree (io::as_robot), and the numbers differ from the
@@ -28,6 +30,7 @@
 /// the same call's inputs.
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -71,7 +74,13 @@ struct nh_forward_partials {
   Eigen::MatrixXd A, B;
 };
 
-class robot_dynamics {
+/// The class behind `robot_dynamics` (below). It is a template only so that, header-only, its
+/// bodies are compiled where a program uses them and not in every file that includes this
+/// header; Scalar is double (other scalars: the template API).
+template <class Scalar = double>
+class basic_robot_dynamics {
+  static_assert(std::is_same_v<Scalar, double>, "robot_dynamics is the double front end; other scalars: nhdyn.hpp");
+
  public:
   /// A vector argument: an Eigen vector of double, a segment, a map (read in place when
   /// contiguous).
@@ -79,77 +88,79 @@ class robot_dynamics {
 
   /// The robot that `robot` names: a preset, a URDF, a robot file (a URDF with its base
   /// constraint, docs/model-format.md) or a JSON model (io::load_robot, the scenes' loader).
-  NHDYN_COMPILED_INLINE static robot_dynamics load(const std::string& robot);
+  static basic_robot_dynamics load(const std::string& robot);
   /// A robot already loaded (io::load_robot_file, io::as_robot, io::lock_robot).
-  NHDYN_COMPILED_INLINE explicit robot_dynamics(const io::robot_model& robot);
+  explicit basic_robot_dynamics(const io::robot_model& robot);
   /// Copies share the one immutable model. There is no move: a "move" copies the shared
   /// pointer, so that no robot_dynamics is ever empty.
-  robot_dynamics(const robot_dynamics&) = default;
-  robot_dynamics& operator=(const robot_dynamics&) = default;
+  basic_robot_dynamics(const basic_robot_dynamics&) = default;
+  basic_robot_dynamics& operator=(const basic_robot_dynamics&) = default;
 
   /// The loaded robot: its tree and its constraint, for the template API (io/robot_file.hpp).
-  NHDYN_COMPILED_INLINE const io::robot_model& robot() const;
-  NHDYN_COMPILED_INLINE const std::string& name() const;
+  const io::robot_model& robot() const;
+  const std::string& name() const;
   /// n (the size of q, q̇, q̈, v), m (of η; n without a constraint), k (constraint rows; 0
   /// without one), p (of τ for inverse_dynamics; m but for wheeled bases with other actuators).
-  NHDYN_COMPILED_INLINE int dof() const;
-  NHDYN_COMPILED_INLINE int m() const;
-  NHDYN_COMPILED_INLINE int k() const;
-  NHDYN_COMPILED_INLINE int p() const;
-  NHDYN_COMPILED_INLINE bool constrained() const;
+  int dof() const;
+  int m() const;
+  int k() const;
+  int p() const;
+  bool constrained() const;
   /// The names of q's, η's and τ's entries.
-  NHDYN_COMPILED_INLINE const std::vector<std::string>& joint_names() const;
-  NHDYN_COMPILED_INLINE const std::vector<std::string>& eta_names() const;
-  NHDYN_COMPILED_INLINE const std::vector<std::string>& tau_names() const;
+  const std::vector<std::string>& joint_names() const;
+  const std::vector<std::string>& eta_names() const;
+  const std::vector<std::string>& tau_names() const;
   /// The index of a name in joint_names(), eta_names() or tau_names(); model_error naming it
   /// and the names there are when it is not one of them.
-  NHDYN_COMPILED_INLINE int joint_index(const std::string& joint) const;
-  NHDYN_COMPILED_INLINE int eta_index(const std::string& name) const;
-  NHDYN_COMPILED_INLINE int tau_index(const std::string& name) const;
+  int joint_index(const std::string& joint) const;
+  int eta_index(const std::string& name) const;
+  int tau_index(const std::string& name) const;
 
   // The tree as if the base were free: the holonomic dynamics (dynamics/).
   /// v = M(q)q̈ + C(q, q̇)q̇ + g(q) (rne); the second form writes v (resized to n).
-  NHDYN_COMPILED_INLINE Eigen::VectorXd rne(vector_arg q, vector_arg qd, vector_arg qdd) const;
-  NHDYN_COMPILED_INLINE void rne(vector_arg q, vector_arg qd, vector_arg qdd, Eigen::VectorXd& v) const;
+  Eigen::VectorXd rne(vector_arg q, vector_arg qd, vector_arg qdd) const;
+  void rne(vector_arg q, vector_arg qd, vector_arg qdd, Eigen::VectorXd& v) const;
   /// M(q) by the composite-rigid-body algorithm; the second form writes M (resized to n × n).
-  NHDYN_COMPILED_INLINE Eigen::MatrixXd mass_matrix(vector_arg q) const;
-  NHDYN_COMPILED_INLINE void mass_matrix(vector_arg q, Eigen::MatrixXd& M) const;
+  Eigen::MatrixXd mass_matrix(vector_arg q) const;
+  void mass_matrix(vector_arg q, Eigen::MatrixXd& M) const;
   /// h(q, q̇) = C(q, q̇)q̇ + g(q).
-  NHDYN_COMPILED_INLINE Eigen::VectorXd bias(vector_arg q, vector_arg qd) const;
+  Eigen::VectorXd bias(vector_arg q, vector_arg qd) const;
   /// q̈ = M⁻¹(τ − h) (forward_dynamics: ABA or CRBA + LDLᵀ, as it chooses for the tree).
-  NHDYN_COMPILED_INLINE Eigen::VectorXd forward_dynamics(vector_arg q, vector_arg qd, vector_arg tau) const;
-  NHDYN_COMPILED_INLINE rne_partials rne_derivatives(vector_arg q, vector_arg qd, vector_arg qdd) const;
-  NHDYN_COMPILED_INLINE forward_partials forward_dynamics_derivatives(vector_arg q, vector_arg qd,
-                                                                      vector_arg tau) const;
+  Eigen::VectorXd forward_dynamics(vector_arg q, vector_arg qd, vector_arg tau) const;
+  rne_partials rne_derivatives(vector_arg q, vector_arg qd, vector_arg qdd) const;
+  forward_partials forward_dynamics_derivatives(vector_arg q, vector_arg qd, vector_arg tau) const;
 
   // The robot on its base constraint: the nonholonomic dynamics (constraints/, analysis/).
   /// τ = (SᵀE)⁻¹Sᵀ rne(lift(q, η, η̇)) (project ∘ rne ∘ lift); the second form writes τ
   /// (resized to p) with no allocation.
-  NHDYN_COMPILED_INLINE Eigen::VectorXd inverse_dynamics(vector_arg q, vector_arg eta, vector_arg eta_dot) const;
-  NHDYN_COMPILED_INLINE void inverse_dynamics(vector_arg q, vector_arg eta, vector_arg eta_dot,
-                                              Eigen::VectorXd& tau) const;
+  Eigen::VectorXd inverse_dynamics(vector_arg q, vector_arg eta, vector_arg eta_dot) const;
+  void inverse_dynamics(vector_arg q, vector_arg eta, vector_arg eta_dot, Eigen::VectorXd& tau) const;
   /// τ and the constraint forces λ: rne(lift(q, η, η̇)) = E(q)τ + A(q)ᵀλ.
-  NHDYN_COMPILED_INLINE robot_forces inverse_dynamics_with_forces(vector_arg q, vector_arg eta,
-                                                                  vector_arg eta_dot) const;
+  robot_forces inverse_dynamics_with_forces(vector_arg q, vector_arg eta, vector_arg eta_dot) const;
   /// η̇ from τ (nh_forward_dynamics).
-  NHDYN_COMPILED_INLINE Eigen::VectorXd nh_forward_dynamics(vector_arg q, vector_arg eta, vector_arg tau) const;
+  Eigen::VectorXd nh_forward_dynamics(vector_arg q, vector_arg eta, vector_arg tau) const;
   /// ξ = (q, S(q)η, S(q)η̇ + Ṡ(q, η)η).
-  NHDYN_COMPILED_INLINE robot_state lift(vector_arg q, vector_arg eta, vector_arg eta_dot) const;
+  robot_state lift(vector_arg q, vector_arg eta, vector_arg eta_dot) const;
   /// q̇ = S(q)η.
-  NHDYN_COMPILED_INLINE Eigen::VectorXd apply_S(vector_arg q, vector_arg eta) const;
+  Eigen::VectorXd apply_S(vector_arg q, vector_arg eta) const;
   /// S(q) (n × m), A(q) (k × n; A S = 0), E(q) (n × p: the actuators' map, S where τ is η's).
-  NHDYN_COMPILED_INLINE Eigen::MatrixXd S(vector_arg q) const;
-  NHDYN_COMPILED_INLINE Eigen::MatrixXd A(vector_arg q) const;
-  NHDYN_COMPILED_INLINE Eigen::MatrixXd input_map(vector_arg q) const;
-  NHDYN_COMPILED_INLINE nh_inverse_partials inverse_dynamics_derivatives(vector_arg q, vector_arg eta,
-                                                                         vector_arg eta_dot) const;
-  NHDYN_COMPILED_INLINE nh_forward_partials nh_forward_dynamics_derivatives(vector_arg q, vector_arg eta,
-                                                                            vector_arg tau) const;
+  Eigen::MatrixXd S(vector_arg q) const;
+  Eigen::MatrixXd A(vector_arg q) const;
+  Eigen::MatrixXd input_map(vector_arg q) const;
+  nh_inverse_partials inverse_dynamics_derivatives(vector_arg q, vector_arg eta, vector_arg eta_dot) const;
+  nh_forward_partials nh_forward_dynamics_derivatives(vector_arg q, vector_arg eta, vector_arg tau) const;
 
  private:
   struct impl;
   std::shared_ptr<const impl> p_;
 };
+
+/// A loaded robot's dynamics in double (see the file comment).
+using robot_dynamics = basic_robot_dynamics<>;
+#if !NHDYN_DEFINES(NHDYN_PART_DYNAMICS)
+/// Linked with nhdyn::compiled: the members are the library's (src/compiled/dynamics.cpp).
+extern template class basic_robot_dynamics<double>;
+#endif
 
 }  // namespace nhdyn
 
@@ -206,7 +217,8 @@ inline int index_of(const std::vector<std::string>& names, const std::string& na
 }
 }  // namespace detail
 
-struct robot_dynamics::impl {
+template <class Scalar>
+struct basic_robot_dynamics<Scalar>::impl {
   io::robot_model robot;
   std::vector<std::string> joints, eta, tau;
   tree_rne_fn<double> rne;
@@ -259,73 +271,97 @@ struct robot_dynamics::impl {
   }
 };
 
-NHDYN_COMPILED_INLINE robot_dynamics robot_dynamics::load(const std::string& robot) {
-  return robot_dynamics(io::load_robot(robot));
+template <class Scalar>
+basic_robot_dynamics<Scalar> basic_robot_dynamics<Scalar>::load(const std::string& robot) {
+  return basic_robot_dynamics(io::load_robot(robot));
 }
-NHDYN_COMPILED_INLINE robot_dynamics::robot_dynamics(const io::robot_model& robot)
+template <class Scalar>
+basic_robot_dynamics<Scalar>::basic_robot_dynamics(const io::robot_model& robot)
     : p_(std::make_shared<const impl>(robot)) {}
 
-NHDYN_COMPILED_INLINE const io::robot_model& robot_dynamics::robot() const { return p_->robot; }
-NHDYN_COMPILED_INLINE const std::string& robot_dynamics::name() const { return p_->robot.name; }
-NHDYN_COMPILED_INLINE int robot_dynamics::dof() const { return int(p_->joints.size()); }
-NHDYN_COMPILED_INLINE int robot_dynamics::m() const { return int(p_->eta.size()); }
-NHDYN_COMPILED_INLINE int robot_dynamics::k() const { return p_->robot.k(); }
-NHDYN_COMPILED_INLINE int robot_dynamics::p() const { return p_->p; }
-NHDYN_COMPILED_INLINE bool robot_dynamics::constrained() const { return p_->nh.has_value(); }
-NHDYN_COMPILED_INLINE const std::vector<std::string>& robot_dynamics::joint_names() const { return p_->joints; }
-NHDYN_COMPILED_INLINE const std::vector<std::string>& robot_dynamics::eta_names() const { return p_->eta; }
-NHDYN_COMPILED_INLINE const std::vector<std::string>& robot_dynamics::tau_names() const { return p_->tau; }
-NHDYN_COMPILED_INLINE int robot_dynamics::joint_index(const std::string& joint) const {
+template <class Scalar>
+const io::robot_model& basic_robot_dynamics<Scalar>::robot() const { return p_->robot; }
+template <class Scalar>
+const std::string& basic_robot_dynamics<Scalar>::name() const { return p_->robot.name; }
+template <class Scalar>
+int basic_robot_dynamics<Scalar>::dof() const { return int(p_->joints.size()); }
+template <class Scalar>
+int basic_robot_dynamics<Scalar>::m() const { return int(p_->eta.size()); }
+template <class Scalar>
+int basic_robot_dynamics<Scalar>::k() const { return p_->robot.k(); }
+template <class Scalar>
+int basic_robot_dynamics<Scalar>::p() const { return p_->p; }
+template <class Scalar>
+bool basic_robot_dynamics<Scalar>::constrained() const { return p_->nh.has_value(); }
+template <class Scalar>
+const std::vector<std::string>& basic_robot_dynamics<Scalar>::joint_names() const { return p_->joints; }
+template <class Scalar>
+const std::vector<std::string>& basic_robot_dynamics<Scalar>::eta_names() const { return p_->eta; }
+template <class Scalar>
+const std::vector<std::string>& basic_robot_dynamics<Scalar>::tau_names() const { return p_->tau; }
+template <class Scalar>
+int basic_robot_dynamics<Scalar>::joint_index(const std::string& joint) const {
   return detail::index_of(p_->joints, joint, p_->robot.name, "joint_index");
 }
-NHDYN_COMPILED_INLINE int robot_dynamics::eta_index(const std::string& name) const {
+template <class Scalar>
+int basic_robot_dynamics<Scalar>::eta_index(const std::string& name) const {
   return detail::index_of(p_->eta, name, p_->robot.name, "eta_index");
 }
-NHDYN_COMPILED_INLINE int robot_dynamics::tau_index(const std::string& name) const {
+template <class Scalar>
+int basic_robot_dynamics<Scalar>::tau_index(const std::string& name) const {
   return detail::index_of(p_->tau, name, p_->robot.name, "tau_index");
 }
 
-NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::rne(vector_arg q, vector_arg qd, vector_arg qdd) const {
+template <class Scalar>
+Eigen::VectorXd basic_robot_dynamics<Scalar>::rne(vector_arg q, vector_arg qd, vector_arg qdd) const {
   return p_->guarded("rne", [&] { return Eigen::VectorXd(p_->rne(q, qd, qdd)); });
 }
-NHDYN_COMPILED_INLINE void robot_dynamics::rne(vector_arg q, vector_arg qd, vector_arg qdd, Eigen::VectorXd& v) const {
+template <class Scalar>
+void basic_robot_dynamics<Scalar>::rne(vector_arg q, vector_arg qd, vector_arg qdd, Eigen::VectorXd& v) const {
   p_->guarded("rne", [&] {
     v.resize(dof());
     p_->rne.evaluate(q, qd, qdd, v);
   });
 }
-NHDYN_COMPILED_INLINE Eigen::MatrixXd robot_dynamics::mass_matrix(vector_arg q) const {
+template <class Scalar>
+Eigen::MatrixXd basic_robot_dynamics<Scalar>::mass_matrix(vector_arg q) const {
   return p_->guarded("mass_matrix", [&] { return Eigen::MatrixXd(p_->M(q)); });
 }
-NHDYN_COMPILED_INLINE void robot_dynamics::mass_matrix(vector_arg q, Eigen::MatrixXd& M) const {
+template <class Scalar>
+void basic_robot_dynamics<Scalar>::mass_matrix(vector_arg q, Eigen::MatrixXd& M) const {
   p_->guarded("mass_matrix", [&] { p_->M.evaluate(q, M); });
 }
-NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::bias(vector_arg q, vector_arg qd) const {
+template <class Scalar>
+Eigen::VectorXd basic_robot_dynamics<Scalar>::bias(vector_arg q, vector_arg qd) const {
   return p_->guarded("bias", [&] { return Eigen::VectorXd(p_->bias(q, qd)); });
 }
-NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::forward_dynamics(vector_arg q, vector_arg qd, vector_arg tau) const {
+template <class Scalar>
+Eigen::VectorXd basic_robot_dynamics<Scalar>::forward_dynamics(vector_arg q, vector_arg qd, vector_arg tau) const {
   return p_->guarded("forward_dynamics", [&] { return Eigen::VectorXd(p_->fd(q, qd, tau)); });
 }
-NHDYN_COMPILED_INLINE rne_partials robot_dynamics::rne_derivatives(vector_arg q, vector_arg qd, vector_arg qdd) const {
+template <class Scalar>
+rne_partials basic_robot_dynamics<Scalar>::rne_derivatives(vector_arg q, vector_arg qd, vector_arg qdd) const {
   return p_->guarded("rne_derivatives", [&] {
     auto r = p_->rne_derivatives(q, qd, qdd);
     return rne_partials{std::move(r.tau), std::move(r.dq), std::move(r.dqd), std::move(r.M)};
   });
 }
-NHDYN_COMPILED_INLINE forward_partials robot_dynamics::forward_dynamics_derivatives(vector_arg q, vector_arg qd,
-                                                                                    vector_arg tau) const {
+template <class Scalar>
+forward_partials basic_robot_dynamics<Scalar>::forward_dynamics_derivatives(vector_arg q, vector_arg qd,
+                                                                            vector_arg tau) const {
   return p_->guarded("forward_dynamics_derivatives", [&] {
     auto r = p_->fd_derivatives(q, qd, tau);
     return forward_partials{std::move(r.qdd), std::move(r.dq), std::move(r.dqd), std::move(r.Minv)};
   });
 }
 
-NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::inverse_dynamics(vector_arg q, vector_arg eta,
-                                                                      vector_arg eta_dot) const {
+template <class Scalar>
+Eigen::VectorXd basic_robot_dynamics<Scalar>::inverse_dynamics(vector_arg q, vector_arg eta, vector_arg eta_dot) const {
   return p_->on_constraint("inverse_dynamics", [&](const auto& x) -> Eigen::VectorXd { return x.id(q, eta, eta_dot); });
 }
-NHDYN_COMPILED_INLINE void robot_dynamics::inverse_dynamics(vector_arg q, vector_arg eta, vector_arg eta_dot,
-                                                            Eigen::VectorXd& tau) const {
+template <class Scalar>
+void basic_robot_dynamics<Scalar>::inverse_dynamics(vector_arg q, vector_arg eta, vector_arg eta_dot,
+                                                    Eigen::VectorXd& tau) const {
   p_->on_constraint("inverse_dynamics", [&](const auto& x) {
     tau.resize(p());
     if constexpr (requires { x.id.evaluate(q, eta, eta_dot, tau); })
@@ -334,24 +370,27 @@ NHDYN_COMPILED_INLINE void robot_dynamics::inverse_dynamics(vector_arg q, vector
       tau = x.id(q, eta, eta_dot);
   });
 }
-NHDYN_COMPILED_INLINE robot_forces robot_dynamics::inverse_dynamics_with_forces(vector_arg q, vector_arg eta,
-                                                                                vector_arg eta_dot) const {
+template <class Scalar>
+robot_forces basic_robot_dynamics<Scalar>::inverse_dynamics_with_forces(vector_arg q, vector_arg eta,
+                                                                        vector_arg eta_dot) const {
   return p_->on_constraint("inverse_dynamics_with_forces", [&](const auto& x) {
     auto f = x.id_forces(q, eta, eta_dot);
     return robot_forces{std::move(f.tau), std::move(f.lambda)};
   });
 }
-NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::nh_forward_dynamics(vector_arg q, vector_arg eta,
-                                                                         vector_arg tau) const {
+template <class Scalar>
+Eigen::VectorXd basic_robot_dynamics<Scalar>::nh_forward_dynamics(vector_arg q, vector_arg eta, vector_arg tau) const {
   return p_->on_constraint("nh_forward_dynamics", [&](const auto& x) -> Eigen::VectorXd { return x.fd(q, eta, tau); });
 }
-NHDYN_COMPILED_INLINE robot_state robot_dynamics::lift(vector_arg q, vector_arg eta, vector_arg eta_dot) const {
+template <class Scalar>
+robot_state basic_robot_dynamics<Scalar>::lift(vector_arg q, vector_arg eta, vector_arg eta_dot) const {
   return p_->on_constraint("lift", [&](const auto& x) {
     auto xi = x.lifting(q, eta, eta_dot);
     return robot_state{std::move(xi.q), std::move(xi.qd), std::move(xi.qdd)};
   });
 }
-NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::apply_S(vector_arg q, vector_arg eta) const {
+template <class Scalar>
+Eigen::VectorXd basic_robot_dynamics<Scalar>::apply_S(vector_arg q, vector_arg eta) const {
   return p_->on_constraint("apply_S", [&](const auto& x) -> Eigen::VectorXd {
     detail::check_size(q, x.c.dof(), "q");
     detail::check_size(eta, x.c.m(), "eta");
@@ -360,36 +399,41 @@ NHDYN_COMPILED_INLINE Eigen::VectorXd robot_dynamics::apply_S(vector_arg q, vect
     return nhdyn::apply_S(x.c, q, eta);
   });
 }
-NHDYN_COMPILED_INLINE Eigen::MatrixXd robot_dynamics::S(vector_arg q) const {
+template <class Scalar>
+Eigen::MatrixXd basic_robot_dynamics<Scalar>::S(vector_arg q) const {
   return p_->on_constraint("S", [&](const auto& x) -> Eigen::MatrixXd {
     detail::check_size(q, x.c.dof(), "q");
     detail::check_finite(q, "q");
     return x.c.S(q);
   });
 }
-NHDYN_COMPILED_INLINE Eigen::MatrixXd robot_dynamics::A(vector_arg q) const {
+template <class Scalar>
+Eigen::MatrixXd basic_robot_dynamics<Scalar>::A(vector_arg q) const {
   return p_->on_constraint("A", [&](const auto& x) -> Eigen::MatrixXd {
     detail::check_size(q, x.c.dof(), "q");
     detail::check_finite(q, "q");
     return x.c.A(q);
   });
 }
-NHDYN_COMPILED_INLINE Eigen::MatrixXd robot_dynamics::input_map(vector_arg q) const {
+template <class Scalar>
+Eigen::MatrixXd basic_robot_dynamics<Scalar>::input_map(vector_arg q) const {
   return p_->on_constraint("input_map", [&](const auto& x) -> Eigen::MatrixXd {
     detail::check_size(q, x.c.dof(), "q");
     detail::check_finite(q, "q");
     return nhdyn::input_map(x.c, q);
   });
 }
-NHDYN_COMPILED_INLINE nh_inverse_partials robot_dynamics::inverse_dynamics_derivatives(vector_arg q, vector_arg eta,
-                                                                                       vector_arg eta_dot) const {
+template <class Scalar>
+nh_inverse_partials basic_robot_dynamics<Scalar>::inverse_dynamics_derivatives(vector_arg q, vector_arg eta,
+                                                                               vector_arg eta_dot) const {
   return p_->on_constraint("inverse_dynamics_derivatives", [&](const auto& x) {
     auto r = x.id_derivatives(q, eta, eta_dot);
     return nh_inverse_partials{std::move(r.tau), std::move(r.dq), std::move(r.deta), std::move(r.deta_dot)};
   });
 }
-NHDYN_COMPILED_INLINE nh_forward_partials robot_dynamics::nh_forward_dynamics_derivatives(vector_arg q, vector_arg eta,
-                                                                                          vector_arg tau) const {
+template <class Scalar>
+nh_forward_partials basic_robot_dynamics<Scalar>::nh_forward_dynamics_derivatives(vector_arg q, vector_arg eta,
+                                                                                  vector_arg tau) const {
   return p_->on_constraint("nh_forward_dynamics_derivatives", [&](const auto& x) {
     auto r = x.fd_derivatives(q, eta, tau);
     return nh_forward_partials{std::move(r.eta_dot), std::move(r.ss.A), std::move(r.ss.B)};

@@ -8,4 +8,6 @@
 
 namespace nhdyn {
 template run_result simulate_scene_fn::operator()<run_spec>(const run_spec&) const;
+template detail::scene_setup detail::setup_scene<run_spec>(const run_spec&);
+template Eigen::Matrix<double, 6, 6> lyapunov_P<>(const Eigen::Matrix3d&, const Eigen::Matrix3d&);
 }  // namespace nhdyn

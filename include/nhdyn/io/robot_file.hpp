@@ -84,29 +84,35 @@ struct robot_model {
 /// (model/lock.hpp's lock on its tree); its constraint is read again on the smaller tree. A
 /// joint the constraint involves (the planar base's, a wheel's, a castor's) cannot be
 /// locked: model_error naming it and the constraint. `where` begins every message.
-NHDYN_COMPILED_INLINE robot_model lock_robot(robot_model r, const std::vector<std::pair<std::string, double>>& locks,
-                                             const std::string& where);
+template <class = void>
+robot_model lock_robot(robot_model r, const std::vector<std::pair<std::string, double>>& locks,
+                       const std::string& where);
 /// A JSON model (a DH chain, its optional differential_drive, its "locked" joints) as a
 /// robot: the chain as a tree (as_tree: joints joint1…, bodies link1…, the base `base`), the
 /// constraint on it with the same joint indices, and the locked joints held (lock_robot:
 /// a joint of the constraint cannot be). A DH chain with joints held is no longer a DH chain;
 /// this is how the tool, scenes and Python load a model file with "locked". `where` begins
 /// the messages about the locked joints.
-NHDYN_COMPILED_INLINE robot_model as_robot(const model<double>& m, const std::string& where = "locked: ");
+template <class = void>
+robot_model as_robot(const model<double>& m, const std::string& where = "locked: ");
 /// The robot file's text; `path` locates the URDF (relative paths from its folder) and names
 /// the file in messages.
-NHDYN_COMPILED_INLINE robot_model parse_robot_file(const std::string& text, const std::string& path, urdf_options opt = {});
+template <class = void>
+robot_model parse_robot_file(const std::string& text, const std::string& path, urdf_options opt = {});
 /// r's constraint read again on the tree t (r's joints, other placements: a plant whose link
 /// lengths differ from the file's), so that the geometry a constraint takes from the URDF
 /// (the wheels' positions) follows t. Warnings were given when r was loaded: none again.
 /// Empty when r has no constraint.
-NHDYN_COMPILED_INLINE std::optional<robot_constraint> constraint_on(const robot_model& r, const tree<double>& t);
+template <class = void>
+std::optional<robot_constraint> constraint_on(const robot_model& r, const tree<double>& t);
 /// The robot file at `path`.
-NHDYN_COMPILED_INLINE robot_model load_robot_file(const std::string& path, urdf_options opt = {});
+template <class = void>
+robot_model load_robot_file(const std::string& path, urdf_options opt = {});
 /// The robot that `spec` names, whatever it is: a preset (io::preset_names), a URDF (`.urdf`:
 /// no constraint), a robot file (a JSON object with "urdf") or a JSON model (a DH chain, as a
 /// tree: as_robot). The loader of scenes, robot_dynamics and the tool's robot arguments.
-NHDYN_COMPILED_INLINE robot_model load_robot(const std::string& spec);
+template <class = void>
+robot_model load_robot(const std::string& spec);
 
 #if NHDYN_DEFINES(NHDYN_PART_IO)
 namespace detail {
@@ -172,7 +178,8 @@ inline std::vector<std::string> name_list(const json& c, const place& at, std::s
 }
 
 /// A "wheeled_base" constraint object: its wheels, eta, actuated and weights.
-inline wheeled_base<double> read_wheeled_base(const json& c, const tree<double>& t, const place& at, const urdf_options& opt) {
+template <class = void>  // compiled where used (config.hpp)
+wheeled_base<double> read_wheeled_base(const json& c, const tree<double>& t, const place& at, const urdf_options& opt) {
   check_keys(c, {"type", "wheels", "eta", "actuated", "weights"}, {"wheels"}, at.prefix + ", ", "the constraint");
   const json& ws = c["wheels"];
   if (!ws.is_array() || ws.empty()) throw model_error(at.field("wheels") + "expected a non-empty list of wheels, got " + describe(ws));
@@ -224,8 +231,9 @@ inline wheeled_base<double> read_wheeled_base(const json& c, const tree<double>&
   return wheeled_base<double>(t, std::move(wheels), std::move(o));
 }
 
-inline robot_constraint read_robot_constraint(const json& c, const tree<double>& t, const place& top,
-                                              const urdf_options& opt) {
+template <class = void>  // compiled where used (config.hpp)
+robot_constraint read_robot_constraint(const json& c, const tree<double>& t, const place& top,
+                                       const urdf_options& opt) {
   const place at{top.prefix + ", constraint"};
   const std::string known = "(known: differential_drive, wheels, bicycle, wheeled_base)";
   if (!c.is_object() || !c.contains("type") || !c["type"].is_string())
@@ -309,7 +317,8 @@ inline robot_constraint read_robot_constraint(const json& c, const tree<double>&
 namespace detail {
 /// The tree with the drives a robot file's "drives" gives by joint name (armature, friction;
 /// or motor side, as in JSON models), over what the URDF's <dynamics> said.
-inline tree<double> with_drives(const tree<double>& t, const json& d, const place& top) {
+template <class = void>  // compiled where used (config.hpp)
+tree<double> with_drives(const tree<double>& t, const json& d, const place& top) {
   if (!d.is_object()) throw model_error(top.field("drives") + "expected an object {joint name: drive}, got " + describe(d));
   std::vector<body<double>> bodies = t.bodies();
   for (auto it = d.begin(); it != d.end(); ++it) {
@@ -356,8 +365,9 @@ std::vector<bool> constraint_joints(const C& c, int n) {
 
 }  // namespace detail
 
-NHDYN_COMPILED_INLINE robot_model lock_robot(robot_model r, const std::vector<std::pair<std::string, double>>& locks,
-                                             const std::string& where) {
+template <class>
+robot_model lock_robot(robot_model r, const std::vector<std::pair<std::string, double>>& locks,
+                       const std::string& where) {
   if (locks.empty()) return r;
   lock_map m;
   try {
@@ -399,14 +409,16 @@ NHDYN_COMPILED_INLINE robot_model lock_robot(robot_model r, const std::vector<st
   return r;
 }
 
-NHDYN_COMPILED_INLINE robot_model as_robot(const model<double>& m, const std::string& where) {
+template <class>
+robot_model as_robot(const model<double>& m, const std::string& where) {
   robot_model r{.model = as_tree(m.chain), .constraint = std::nullopt, .name = m.chain.name(),
                 .constraint_source = {}, .path = {}, .planar_base = false, .locked = {}};
   if (m.constraint) r.constraint = *m.constraint;
   return lock_robot(std::move(r), m.locked, where);
 }
 
-NHDYN_COMPILED_INLINE robot_model parse_robot_file(const std::string& text, const std::string& path, urdf_options opt) {
+template <class>
+robot_model parse_robot_file(const std::string& text, const std::string& path, urdf_options opt) {
   const std::string where = "robot file '" + path + "': ";
   const json j = parse_strict(text, where);
   if (!j.is_object()) throw model_error(where + "expected a JSON object, got " + detail::describe(j));
@@ -440,7 +452,8 @@ NHDYN_COMPILED_INLINE robot_model parse_robot_file(const std::string& text, cons
   return out;
 }
 
-NHDYN_COMPILED_INLINE std::optional<robot_constraint> constraint_on(const robot_model& r, const tree<double>& t) {
+template <class>
+std::optional<robot_constraint> constraint_on(const robot_model& r, const tree<double>& t) {
   if (r.constraint_source.is_null()) return r.constraint;
   urdf_options opt;
   opt.planar_base = r.planar_base;
@@ -448,7 +461,8 @@ NHDYN_COMPILED_INLINE std::optional<robot_constraint> constraint_on(const robot_
   return detail::read_robot_constraint(r.constraint_source, t, detail::place{"robot file '" + r.path + "'"}, opt);
 }
 
-NHDYN_COMPILED_INLINE robot_model load_robot(const std::string& spec) {
+template <class>
+robot_model load_robot(const std::string& spec) {
   const auto presets = preset_names();
   std::string ext = std::filesystem::path(spec).extension().string();
   for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
@@ -461,13 +475,23 @@ NHDYN_COMPILED_INLINE robot_model load_robot(const std::string& spec) {
   const bool preset = std::find(presets.begin(), presets.end(), spec) != presets.end();
   if (!preset) {
     std::ifstream in(spec);
-    if (const auto j = json::parse(in, nullptr, false); j.is_object() && j.contains("urdf")) return load_robot_file(spec);
+    if (const auto j = json::parse(in, nullptr, false); j.is_object()) {
+      if (j.contains("urdf")) return load_robot_file(spec);
+      if (!j.contains("links")) {  // neither kind: say so, not the model parser's "unknown key"
+        std::string keys;
+        for (const auto& [key, value] : j.items()) keys += (keys.empty() ? "'" : ", '") + key + "'";
+        throw model_error("robot '" + spec + "': a JSON object that is neither a robot file (it needs \"urdf\", "
+                          "docs/model-format.md) nor a DH model file (it needs \"links\"); its keys: " +
+                          (keys.empty() ? std::string("none") : keys));
+      }
+    }  // not JSON: the model loader names the error and its line
   }
   robot_model r = as_robot(load<double>(spec), "robot '" + spec + "', locked: ");
   r.path = spec;
   return r;
 }
-NHDYN_COMPILED_INLINE robot_model load_robot_file(const std::string& path, urdf_options opt) {
+template <class>
+robot_model load_robot_file(const std::string& path, urdf_options opt) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw model_error("robot file '" + path + "': cannot open the file");
   std::ostringstream ss;

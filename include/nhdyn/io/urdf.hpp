@@ -63,9 +63,11 @@ struct urdf_options {
 };
 
 /// A URDF document (its text) as a tree. `where` names it in messages (a file name).
-NHDYN_COMPILED_INLINE tree<double> parse_urdf(const std::string& text, const std::string& where = "URDF", urdf_options opt = {});
+template <class = void>
+tree<double> parse_urdf(const std::string& text, const std::string& where = "URDF", urdf_options opt = {});
 /// The URDF file at `path` as a tree; messages name the file.
-NHDYN_COMPILED_INLINE tree<double> load_urdf(const std::string& path, urdf_options opt = {});
+template <class = void>
+tree<double> load_urdf(const std::string& path, urdf_options opt = {});
 
 #if NHDYN_DEFINES(NHDYN_PART_IO)
 namespace detail {
@@ -161,7 +163,8 @@ inline std::string joint_cycle(const urdf_document& doc) {
 
 }  // namespace detail
 
-NHDYN_COMPILED_INLINE tree<double> parse_urdf(const std::string& text, const std::string& where, urdf_options opt) {
+template <class>
+tree<double> parse_urdf(const std::string& text, const std::string& where, urdf_options opt) {
   const std::string at = where + ": ";
   const detail::urdf_document doc = detail::read_document(text, at);
   if (const std::string cycle = detail::joint_cycle(doc); !cycle.empty())
@@ -226,7 +229,8 @@ NHDYN_COMPILED_INLINE tree<double> parse_urdf(const std::string& text, const std
 
   // A link's own inertial, checked, in the frame of the body it joins.
   const auto add_inertial = [&](const urdf::Link& L, const placed& pl) {
-    if (!L.inertial || pl.body < 0) return;
+    // (pl.body): in a template, clang 14 reads `pl.body <` as the class template body<…>
+    if (!L.inertial || (pl.body) < 0) return;
     const auto& in = *L.inertial;
     const std::string here = "link '" + L.name + "'" + line_of_link(L.name) + ": ";
     Eigen::Matrix3d Ic;
@@ -355,7 +359,8 @@ NHDYN_COMPILED_INLINE tree<double> parse_urdf(const std::string& text, const std
                       std::move(frames));
 }
 
-NHDYN_COMPILED_INLINE tree<double> load_urdf(const std::string& path, urdf_options opt) {
+template <class>
+tree<double> load_urdf(const std::string& path, urdf_options opt) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw model_error(path + ": cannot open the file");
   std::ostringstream ss;

@@ -61,9 +61,11 @@ struct rac_gains {
 /// P with A_cᵀP + PA_c = −I₆, A_c = [0 I; −K₀ −K₁], by the vectorised (Kronecker) linear
 /// system (I ⊗ A_cᵀ + A_cᵀ ⊗ I) vec P = −vec I. Throws numerical_error if A_c is not
 /// Hurwitz (P not positive definite).
-NHDYN_COMPILED_INLINE Eigen::Matrix<double, 6, 6> lyapunov_P(const Eigen::Matrix3d& K0, const Eigen::Matrix3d& K1);
+template <class = void>
+Eigen::Matrix<double, 6, 6> lyapunov_P(const Eigen::Matrix3d& K0, const Eigen::Matrix3d& K1);
 #if NHDYN_DEFINES(NHDYN_PART_SIMULATION)
-NHDYN_COMPILED_INLINE Eigen::Matrix<double, 6, 6> lyapunov_P(const Eigen::Matrix3d& K0, const Eigen::Matrix3d& K1) {
+template <class>
+Eigen::Matrix<double, 6, 6> lyapunov_P(const Eigen::Matrix3d& K0, const Eigen::Matrix3d& K1) {
   using M6 = Eigen::Matrix<double, 6, 6>;
   M6 Ac = M6::Zero();
   Ac.topRightCorner<3, 3>().setIdentity();

@@ -88,10 +88,6 @@ inline tree<double> with_length_factors(const tree<double>& t, const std::vector
   return tree<double>(std::move(B), t.gravity(), t.name(), t.validation_policy(), t.root_name(), t.frames());
 }
 
-/// The robot a scene names (not paper5, which `simulate` runs): a preset, a URDF, a robot file
-/// or a JSON model, as a tree with its optional constraint (io::load_robot).
-inline io::robot_model load_scene_robot(const std::string& robot) { return io::load_robot(robot); }
-
 namespace detail {
 /// A scene's robot set up as trees (see the file comment): plant and nominal model, the
 /// constraint of each (none: holonomic), the task body (1-based) and point, the initial
@@ -110,10 +106,13 @@ struct scene_setup {
 
 /// The set-up of scene s (throws for one that cannot be set up). In nhdyn::compiled: its body
 /// instantiates every constraint type's construction (wheeled_base's SVD among them), 7.7 s of
-/// g++'s time at -O1 in each file that includes this header.
-NHDYN_COMPILED_INLINE scene_setup setup_scene(const run_spec& s);
+/// g++'s time at -O1. A template (Spec is run_spec), so that header-only it is compiled only
+/// in the files that run a scene, not in every file that includes this header.
+template <std::same_as<run_spec> Spec>
+scene_setup setup_scene(const Spec& s);
 #if NHDYN_DEFINES(NHDYN_PART_SIMULATION)
-NHDYN_COMPILED_INLINE scene_setup setup_scene(const run_spec& s) {
+template <std::same_as<run_spec> Spec>
+scene_setup setup_scene(const Spec& s) {
   const std::string where = "scene '" + s.name + "': ";
   scene_setup out;
   // the trees as their terms want them (after everything else read them: the constraints, frames)
@@ -134,7 +133,7 @@ NHDYN_COMPILED_INLINE scene_setup setup_scene(const run_spec& s) {
     out.eta_names = c.eta_names(out.plant.joint_names());
     return apply_terms(out);
   }
-  const io::robot_model r = io::lock_robot(load_scene_robot(s.robot), s.locked, where + "field 'locked': ");
+  const io::robot_model r = io::lock_robot(io::load_robot(s.robot), s.locked, where + "field 'locked': ");
   const int n = r.model.dof(), m = n - r.k();
   out.robot = r.name;
   detail::check_reference(s, n);
@@ -143,7 +142,8 @@ NHDYN_COMPILED_INLINE scene_setup setup_scene(const run_spec& s) {
   const auto f = r.model.find_frame(s.task_frame);  // throws naming the frame and the known ones
   out.point = f.R * s.task_point + f.p;
   out.body = f.body + 1;
-  if (out.body < 1) throw input_error(where + "field 'task.frame': '" + s.task_frame + "' is fixed to the world; name a moving body");
+  // (out.body): in a template, clang 14 reads `out.body <` as the class template body<…>
+  if ((out.body) < 1) throw input_error(where + "field 'task.frame': '" + s.task_frame + "' is fixed to the world; name a moving body");
   const auto sized = [&](const Eigen::VectorXd& v, int size, const char* what) {
     if (v.size() == 0) return Eigen::VectorXd(Eigen::VectorXd::Zero(size));
     if (v.size() != size)
