@@ -226,6 +226,8 @@ TEST_CASE("robot_dynamics: a JSON file that is neither a robot file nor a model 
                     "robot '" + typo + "': a JSON object that is neither a robot file (it needs \"urdf\", "
                     "docs/model-format.md) nor a DH model file (it needs \"links\"); its keys: 'base', 'name', 'urdff'");
   CHECK_THROWS_AS(nhdyn::robot_dynamics::load(typo), nhdyn::model_error);
+  const auto empty = write("empty.json", "{}");
+  CHECK_THROWS_WITH(nhdyn::robot_dynamics::load(empty), Catch::EndsWith("; its keys: none"));
   // not JSON at all: the error names the file and the line
   const auto broken = write("broken.json", "{\n  \"name\": \"r\",\n  \"urdf\" \"robot.urdf\"\n}\n");
   CHECK_THROWS_WITH(nhdyn::robot_dynamics::load(broken), Catch::Contains(broken) && Catch::Contains("line 3"));

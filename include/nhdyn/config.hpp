@@ -8,10 +8,10 @@
 /// (docs/install.md lists them).
 ///
 /// - Header-only (nothing defined): every function is defined in its header. A compiled
-///   function is a function template with one defaulted, unused parameter
-///   (`template <class = void>`; robot_dynamics is the class template basic_robot_dynamics), so
-///   that header-only its body is compiled only in the files that call it, not in every file
-///   that includes its header.
+///   function is a template: one defaulted, unused parameter (`template <class = void>`), or
+///   `run_spec` (simulate_scene, setup_scene), or a member of basic_robot_dynamics<double>
+///   (robot_dynamics), so that header-only its body is compiled only in the files that call
+///   it, not in every file that includes its header.
 /// - `NHDYN_COMPILED` (set by linking `nhdyn::compiled`): the headers declare the compiled
 ///   functions and leave out their definitions (and the urdfdom and tinyxml2 headers they
 ///   need); the program links them from the library, which instantiates each once

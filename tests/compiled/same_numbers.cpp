@@ -3,7 +3,7 @@
 /// Prints in hexadecimal floating point everything the URDF and robot-file loaders give for
 /// each shipped robot file: every body's constants, the frames, gravity; the constraint's A(q)
 /// and S(q)η at a state; and one rne at that state; then every call of robot_dynamics (the front
-/// end with no templates, robot_dynamics.hpp) at a state, its rne and inverse dynamics checked
+/// end compiled in the library, robot_dynamics.hpp) at a state, its rne and inverse dynamics checked
 /// equal to the template API's bit for bit. Then the first 0.3 s of three shipped scenes
 /// (`simulate_scene`: a mecanum base, the wheeled mobile manipulator, paper5 as a DH chain),
 /// every logged row. tests/compiled.cmake builds this file
@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
           *r.constraint);
     for (const auto& name : r.tau_names()) std::printf("tau %s\n", name.c_str());
 
-    // robot_dynamics: every call, compiled (in nhdyn::compiled) or header-only (inline here)
+    // robot_dynamics: every call, compiled (in nhdyn::compiled) or header-only (instantiated here)
     const nhdyn::robot_dynamics rd(r);
     const Eigen::VectorXd v = rd.rne(q, qd, qdd);
     if (v != nhdyn::rne(t)(q, qd, qdd)) {

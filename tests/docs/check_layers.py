@@ -21,7 +21,7 @@ LAYERS = [
     ["analysis"],      # linearisation, bounds
     ["io"],            # files
     ["simulation"],
-    ["robot_dynamics.hpp"],  # a loaded robot's double dynamics behind a class with no templates
+    ["robot_dynamics.hpp"],  # a loaded robot's double dynamics, compiled once in nhdyn::compiled
     ["nhdyn.hpp"],     # everything
 ]
 __doc__ += "\n    " + " < ".join("/".join(l) for l in LAYERS)

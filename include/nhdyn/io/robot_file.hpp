@@ -110,7 +110,8 @@ template <class = void>
 robot_model load_robot_file(const std::string& path, urdf_options opt = {});
 /// The robot that `spec` names, whatever it is: a preset (io::preset_names), a URDF (`.urdf`:
 /// no constraint), a robot file (a JSON object with "urdf") or a JSON model (a DH chain, as a
-/// tree: as_robot). The loader of scenes, robot_dynamics and the tool's robot arguments.
+/// tree: as_robot). The loader of scenes, robot_dynamics and the tool's robot arguments. A JSON
+/// object with neither "urdf" nor "links" is model_error naming its keys.
 template <class = void>
 robot_model load_robot(const std::string& spec);
 

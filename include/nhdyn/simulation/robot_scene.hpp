@@ -142,8 +142,7 @@ scene_setup setup_scene(const Spec& s) {
   const auto f = r.model.find_frame(s.task_frame);  // throws naming the frame and the known ones
   out.point = f.R * s.task_point + f.p;
   out.body = f.body + 1;
-  // (out.body): in a template, clang 14 reads `out.body <` as the class template body<…>
-  if ((out.body) < 1) throw input_error(where + "field 'task.frame': '" + s.task_frame + "' is fixed to the world; name a moving body");
+  if (out.body < 1) throw input_error(where + "field 'task.frame': '" + s.task_frame + "' is fixed to the world; name a moving body");
   const auto sized = [&](const Eigen::VectorXd& v, int size, const char* what) {
     if (v.size() == 0) return Eigen::VectorXd(Eigen::VectorXd::Zero(size));
     if (v.size() != size)
