@@ -29,5 +29,9 @@ else
   extra=(-DCMAKE_BUILD_TYPE=Release -DNHDYN_PROGRAM_OPT=-O1 -DNHDYN_BUILD_EXAMPLES=ON)
 fi
 cmake -S . -B "$dir" -DNHDYN_BUILD_TESTS=ON "${extra[@]}" >/dev/null
+t0=$SECONDS
 cmake --build "$dir" -j"$(nproc)" "${targets[@]}"
-cd "$dir" && ctest --output-on-failure -j"$(nproc)" "${select[@]}"
+echo "test.sh: $dir built in $(( SECONDS - t0 )) s"
+t0=$SECONDS
+(cd "$dir" && ctest --output-on-failure -j"$(nproc)" "${select[@]}")
+echo "test.sh: $dir tested in $(( SECONDS - t0 )) s"
