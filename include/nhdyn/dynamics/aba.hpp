@@ -229,12 +229,23 @@ NHDYN_FLATTEN void tree_aba_kernel_flat(const std::vector<tree_link<LS>>& L, con
 }
 /// Links in T, or in double for T a SIMD pack (constants broadcast where used).
 template <class T, class LS, class Q, class QD, class TAU, class QDD, class Check>
-void tree_aba_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, const Q& q, const QD& qd, const TAU& tau,
-                     QDD& qdd, const Check& check) {
+void tree_aba_kernel_on(const std::vector<tree_link<LS>>& L, const vec3<T>& g, const Q& q, const QD& qd,
+                        const TAU& tau, QDD& qdd, const Check& check) {
   if constexpr (flatten_kernels<T>)
     tree_aba_kernel_flat<T>(L, g, q, qd, tau, qdd, check);
   else
     tree_aba_kernel_impl<T>(L, g, q, qd, tau, qdd, check);
+}
+/// The kernel on maps of the vectors (kernel_vector): one kernel per scalar and check,
+/// whatever Eigen types the caller passes.
+template <class T, class LS, class Q, class QD, class TAU, class QDD, class Check>
+void tree_aba_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, const Q& q, const QD& qd, const TAU& tau,
+                     QDD& qdd, const Check& check) {
+  const kernel_input<dynamic, Q> qi(q);
+  const kernel_input<dynamic, QD> qdi(qd);
+  const kernel_input<dynamic, TAU> taui(tau);
+  decltype(auto) out = kernel_vector<dynamic>(qdd);
+  tree_aba_kernel_on<T>(L, g, qi.get(), qdi.get(), taui.get(), out, check);
 }
 
 }  // namespace detail

@@ -20,9 +20,10 @@
 /// q̈ = M⁻¹(τ − h − τ_f(q̇)) (dynamics/terms.hpp: the terms a computation includes).
 ///
 /// `evaluate(q, q̇, τ, ws, q̈)` writes q̈ into a vector the caller reuses, with M, h, M's
-/// factor and (with friction) τ − τ_f(q̇) in a `forward_dynamics_scratch` reused as well: on a
-/// chain or a tree of any size, no heap allocation once both have their size (ABA's scratch
-/// beyond its stack part, 51 bodies, is a block its thread keeps: detail/small_buffer.hpp).
+/// factor, a zero q̈ for h and (with friction) τ − τ_f(q̇) in a `forward_dynamics_scratch`
+/// reused as well: on a chain or a tree of any size, no heap allocation once both have their
+/// size (ABA's scratch beyond its stack part, 51 bodies, is a block its thread keeps:
+/// detail/small_buffer.hpp).
 /// The call runs the same steps in a workspace its thread keeps (detail::thread_kept): in the
 /// model's scalar, with friction and applied forces too (those that write into storage, as
 /// external_wrenches does), q̈ is its one allocation.
@@ -55,6 +56,7 @@ struct forward_dynamics_scratch {
   vecN<T, N> h;
   ldlt<T, N> factor;
   vecN<T, N> net;  ///< τ − τ_f(q̇), with a friction model; τ + Q_ext(q) (− τ_f), with applied forces
+  vecN<T, N> zero;  ///< q̈ = 0, for h = rne(q, q̇, 0): rne reads vectors from storage (kernel_input)
 };
 
 /// Model: chain<S, N> or tree<S> (N = dynamic).
@@ -125,7 +127,7 @@ class forward_dynamics_fn : public stage_tag {
     }
   }
 
-  /// q̈ into qdd (resized to n), with M, h, M's factor and τ − τ_f in ws: the call's numbers,
+  /// q̈ into qdd (resized to n), with M, h, M's factor, a zero q̈ and τ − τ_f in ws: the call's numbers,
   /// bit for bit; storage reused from call to call (see the file comment). Inputs in the model's
   /// scalar; qdd must not alias them.
   template <class Q, class QD, class TAU>
@@ -194,7 +196,8 @@ class forward_dynamics_fn : public stage_tag {
     constexpr bool into = std::is_same_v<T, S> && std::is_same_v<X, S> && std::is_same_v<typename QD::Scalar, S>;
     if constexpr (into) {
       ws.h.resize(n_);
-      rne_.evaluate(q, qd, vecN<X, N>::Zero(n_), ws.h);
+      ws.zero.setZero(n_);
+      rne_.evaluate(q, qd, ws.zero, ws.h);
       M_.evaluate(q, ws.M);
     } else {
       const auto put = [](auto& to, auto&& from) {  // moved in where the types agree: no copy

@@ -76,7 +76,8 @@ class mass_matrix_fn : public stage_tag {
   template <class Q, class Out>
   void fill(const Eigen::MatrixBase<Q>& q, Out& M) const {
     using T = typename Out::Scalar;
-    kernel<T>(q, M);
+    const detail::kernel_input<N, Q> qi(q.derived());  // one kernel per scalar and size
+    kernel<T>(qi.get(), M);
     for (int i = 0; i < n_; ++i)
       if (links_[std::size_t(i)].has_armature) M(i, i) += T(links_[std::size_t(i)].Ia);
   }

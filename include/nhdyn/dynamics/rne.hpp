@@ -433,8 +433,18 @@ class rne_fn : public stage_tag {
     if constexpr (!std::is_same_v<QDDx, std::false_type>) check(qdd, tail_, n_, "qdd");
   }
 
+  /// The kernel on maps of the vectors (detail::kernel_vector): one kernel per scalar, size and
+  /// prelude, whatever Eigen types the caller passes.
   template <class Q, class QD, class QDD, class V, class Prelude = detail::no_prelude>
   void run(const Q& q, const QD& qd, const QDD& qdd, V& v, const Prelude& prelude = {}) const {
+    const detail::kernel_input<N, Q> qi(q);
+    const detail::kernel_input<N, QD> qdi(qd);
+    const detail::kernel_input<N, QDD> qddi(qdd);
+    decltype(auto) vv = detail::kernel_vector<N>(v);
+    run_kernel(qi.get(), qdi.get(), qddi.get(), vv, prelude);
+  }
+  template <class Q, class QD, class QDD, class V, class Prelude>
+  void run_kernel(const Q& q, const QD& qd, const QDD& qdd, V& v, const Prelude& prelude) const {
     using T = typename V::Scalar;
     const vec3<T> g = g_.template cast<T>();
     if (opt_.gravity) {

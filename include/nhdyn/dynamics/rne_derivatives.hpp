@@ -268,12 +268,22 @@ NHDYN_FLATTEN bool tree_rne_derivatives_kernel_flat(const std::vector<tree_link<
   return tree_rne_derivatives_kernel<T>(L, g, gravity, q, qd, qdd, fx, out);
 }
 template <class T, class Q, class QD, class QDD, class FX>
-bool rne_derivatives_dispatch(const std::vector<tree_link<T>>& L, const vec3<T>& g, bool gravity, const Q& q,
-                              const QD& qd, const QDD& qdd, const FX& fx, rne_derivatives_result<T>& out) {
+bool rne_derivatives_on(const std::vector<tree_link<T>>& L, const vec3<T>& g, bool gravity, const Q& q, const QD& qd,
+                        const QDD& qdd, const FX& fx, rne_derivatives_result<T>& out) {
   if constexpr (flatten_kernels<T>)
     return tree_rne_derivatives_kernel_flat<T>(L, g, gravity, q, qd, qdd, fx, out);
   else
     return tree_rne_derivatives_kernel<T>(L, g, gravity, q, qd, qdd, fx, out);
+}
+/// The kernel on maps of the vectors (kernel_vector): one kernel per scalar and applied
+/// forces, whatever Eigen types the caller passes.
+template <class T, class Q, class QD, class QDD, class FX>
+bool rne_derivatives_dispatch(const std::vector<tree_link<T>>& L, const vec3<T>& g, bool gravity, const Q& q,
+                              const QD& qd, const QDD& qdd, const FX& fx, rne_derivatives_result<T>& out) {
+  const kernel_input<dynamic, Q> qi(q);
+  const kernel_input<dynamic, QD> qdi(qd);
+  const kernel_input<dynamic, QDD> qddi(qdd);
+  return rne_derivatives_on<T>(L, g, gravity, qi.get(), qdi.get(), qddi.get(), fx, out);
 }
 
 /// External wrenches in the kernel: each wrench's spatial force at its body (world, about

@@ -111,12 +111,23 @@ NHDYN_FLATTEN void tree_rne_kernel_flat(const std::vector<tree_link<LS>>& L, con
   tree_rne_kernel_impl<Gravity, Velocity, T>(L, g, q, qd, qdd, tau);
 }
 template <bool Gravity, bool Velocity, class T, class LS, class Q, class QD, class QDD, class Tau>
-void tree_rne_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd,
-                     Tau& tau) {
+void tree_rne_kernel_on(const std::vector<tree_link<LS>>& L, const vec3<T>& g, const Q& q, const QD& qd,
+                        const QDD& qdd, Tau& tau) {
   if constexpr (flatten_kernels<T>)
     tree_rne_kernel_flat<Gravity, Velocity, T>(L, g, q, qd, qdd, tau);
   else
     tree_rne_kernel_impl<Gravity, Velocity, T>(L, g, q, qd, qdd, tau);
+}
+/// The kernel on maps of the vectors (kernel_vector): one kernel per scalar, whatever Eigen
+/// types the caller passes.
+template <bool Gravity, bool Velocity, class T, class LS, class Q, class QD, class QDD, class Tau>
+void tree_rne_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd,
+                     Tau& tau) {
+  const kernel_input<dynamic, Q> qi(q);
+  const kernel_input<dynamic, QD> qdi(qd);
+  const kernel_input<dynamic, QDD> qddi(qdd);
+  decltype(auto) out = kernel_vector<dynamic>(tau);
+  tree_rne_kernel_on<Gravity, Velocity, T>(L, g, qi.get(), qdi.get(), qddi.get(), out);
 }
 
 /// The CRBA's per-body constants as arrays over the bodies, which its loop over bodies reads
@@ -545,15 +556,17 @@ class tree_mass_matrix_fn : public stage_tag {
     static_assert(std::is_same_v<T, promote_t<S, typename Q::Scalar>>, "H's scalar is the model's and q's");
     detail::check_size(q, n_, "q");
     detail::check_finite(q, "q");
+    const detail::kernel_input<dynamic, Q> qi(q.derived());  // one kernel per scalar, whatever q's type
+    const auto& qv = qi.get();
     if constexpr (flatten_kernels<T> && std::is_same_v<T, S>)
-      detail::tree_crba_kernel_flat<T>(links_, consts_, q, H);
+      detail::tree_crba_kernel_flat<T>(links_, consts_, qv, H);
     else if constexpr (flatten_kernels<T>) {
       const auto L = detail::cast_links<T>(links_);
-      detail::tree_crba_kernel_flat<T>(L, detail::make_crba_constants(L), q, H);
+      detail::tree_crba_kernel_flat<T>(L, detail::make_crba_constants(L), qv, H);
     } else if constexpr (std::is_same_v<T, S>)
-      detail::tree_crba_kernel_local<T>(links_, q, H);
+      detail::tree_crba_kernel_local<T>(links_, qv, H);
     else
-      detail::tree_crba_kernel_local<T>(detail::cast_links<T>(links_), q, H);
+      detail::tree_crba_kernel_local<T>(detail::cast_links<T>(links_), qv, H);
   }
 
  private:

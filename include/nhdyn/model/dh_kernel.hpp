@@ -18,6 +18,64 @@
 
 namespace nhdyn::detail {
 
+/// What a kernel reads and writes a vector argument through: a vector with direct access (a
+/// matrix, a map, a block, a Ref) as a map of its scalar at the model's size N, so that the
+/// kernel is compiled once per scalar, size and contiguity (a strided vector, such as a row
+/// of a matrix, is a second map type), not once per argument type (a kernel was
+/// instantiated for every combination of its callers' Eigen types: 152 copies of rne's in one
+/// test file, where 44 differ in what they compute; docs/performance.md, "Compile times").
+/// Any other expression (a constant, a product) is passed as it is. Reading through a map
+/// gives the same numbers: only where the coefficients come from changes.
+template <int N, class X>
+decltype(auto) kernel_vector(X& x) {
+  using D = std::remove_cvref_t<decltype(x.derived())>;  // X may be an Eigen::MatrixBase<D>
+  constexpr bool direct = (int(D::Flags) & Eigen::DirectAccessBit) != 0 && D::IsVectorAtCompileTime;
+  if constexpr (direct) {
+    constexpr bool writable = !std::is_const_v<X> && (int(D::Flags) & Eigen::LvalueBit) != 0;
+    using V = Eigen::Matrix<typename D::Scalar, N, 1>;
+    using M = std::conditional_t<writable, V, const V>;
+    auto& d = x.derived();
+    if constexpr (D::InnerStrideAtCompileTime == 1)
+      return Eigen::Map<M>(d.data(), d.size());
+    else
+      return Eigen::Map<M, 0, Eigen::InnerStride<>>(d.data(), d.size(), Eigen::InnerStride<>(d.innerStride()));
+  } else {
+    return (x);
+  }
+}
+
+/// An input vector as a kernel reads it: kernel_vector's map where the vector has storage, and
+/// otherwise (an expression: VectorXd::Zero(n), a product) a map of scratch that holds its
+/// values, so that an expression too reaches the kernel as a map, not as a type of its own.
+/// The scratch is on the stack up to 64 entries and beyond in the block its thread keeps
+/// (detail/small_buffer.hpp). Lives as long as the vector it is made from (a temporary is
+/// refused).
+template <int N, class X>
+class kernel_input {
+  using D = std::remove_cvref_t<decltype(std::declval<const X&>().derived())>;
+  using S = typename D::Scalar;
+  static constexpr bool direct = (int(D::Flags) & Eigen::DirectAccessBit) != 0 && D::IsVectorAtCompileTime;
+  struct none {
+    explicit none(int) {}
+  };
+
+ public:
+  explicit kernel_input(const X& x) : x_(x), buf_(static_cast<int>(x.size())) {
+    if constexpr (!direct) Eigen::Map<Eigen::Matrix<S, N, 1>>(buf_.data(), x.size()).noalias() = x;
+  }
+  kernel_input(const X&&) = delete;
+  decltype(auto) get() const {
+    if constexpr (direct)
+      return kernel_vector<N>(x_);
+    else
+      return Eigen::Map<const Eigen::Matrix<S, N, 1>>(buf_.data(), x_.size());
+  }
+
+ private:
+  const X& x_;
+  std::conditional_t<direct, none, small_buffer<S, N, 64>> buf_;
+};
+
 /// The constants of one link, as the recursions use them.
 template <class S>
 struct dh_link {
