@@ -39,7 +39,7 @@ TEST_CASE("smoke: paper5 and puma560 inverse dynamics agree with M qdd + bias") 
 }
 
 // The kernels read their vectors through maps (detail::kernel_vector, kernel_input: one
-// kernel per scalar, whatever Eigen types a caller passes). Each vector type reaches them by
+// kernel per scalar, size and contiguity, whatever Eigen types a caller passes). Each vector type reaches them by
 // its own path: a plain vector, a segment of a longer one, a row of a matrix (a stride), an
 // Eigen::Ref, an expression (evaluated into scratch first). Every path gives the same numbers,
 // bit for bit, as the plain vectors do.

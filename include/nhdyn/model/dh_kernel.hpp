@@ -26,11 +26,12 @@ namespace nhdyn::detail {
 /// test file, where 44 differ in what they compute; docs/performance.md, "Compile times").
 /// Any other expression (a constant, a product) is passed as it is. Reading through a map
 /// gives the same numbers: only where the coefficients come from changes.
+template <class D>
+inline constexpr bool maps_as_vector = (int(D::Flags) & Eigen::DirectAccessBit) != 0 && D::IsVectorAtCompileTime;
 template <int N, class X>
 decltype(auto) kernel_vector(X& x) {
   using D = std::remove_cvref_t<decltype(x.derived())>;  // X may be an Eigen::MatrixBase<D>
-  constexpr bool direct = (int(D::Flags) & Eigen::DirectAccessBit) != 0 && D::IsVectorAtCompileTime;
-  if constexpr (direct) {
+  if constexpr (maps_as_vector<D>) {
     constexpr bool writable = !std::is_const_v<X> && (int(D::Flags) & Eigen::LvalueBit) != 0;
     using V = Eigen::Matrix<typename D::Scalar, N, 1>;
     using M = std::conditional_t<writable, V, const V>;
@@ -54,7 +55,7 @@ template <int N, class X>
 class kernel_input {
   using D = std::remove_cvref_t<decltype(std::declval<const X&>().derived())>;
   using S = typename D::Scalar;
-  static constexpr bool direct = (int(D::Flags) & Eigen::DirectAccessBit) != 0 && D::IsVectorAtCompileTime;
+  static constexpr bool direct = maps_as_vector<D>;
   struct none {
     explicit none(int) {}
   };
