@@ -1,0 +1,44 @@
+/// \file bench/beside_pinocchio/nh.cpp
+/// nhdyn's side: rne, CRBA, ABA and ∂τ/∂(q, q̇) into results the caller reuses (`evaluate`).
+#include <nhdyn/nhdyn.hpp>
+#include <nhdyn/dynamics/rne_derivatives.hpp>
+#include <chrono>
+#include "api.hpp"
+struct nh_ctx {
+  decltype(nhdyn::rne(std::declval<nhdyn::tree<double>>())) id;
+  decltype(nhdyn::mass_matrix(std::declval<nhdyn::tree<double>>())) M;
+  decltype(nhdyn::aba(std::declval<nhdyn::tree<double>>())) fd;
+  decltype(nhdyn::rne_derivatives(std::declval<nhdyn::tree<double>>())) d;
+  Eigen::VectorXd v, a; Eigen::MatrixXd H; nhdyn::rne_derivatives_result<double> r;
+};
+void* nh_make(const nhdyn::tree<double>& t) {
+  const int n = t.dof();
+  auto* c = new nh_ctx{nhdyn::rne(t), nhdyn::mass_matrix(t), nhdyn::aba(t), nhdyn::rne_derivatives(t),
+                       Eigen::VectorXd(n), Eigen::VectorXd(n), Eigen::MatrixXd(n, n), {}};
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(n);
+  c->r = c->d(z, z, z);
+  return c;
+}
+double nh_run(void* p, int algo, const states& s, long K) {
+  auto& c = *static_cast<nh_ctx*>(p);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (long k = 0; k < K; ++k) {
+    const int i = int(k & 63);
+    switch (algo) {
+      case 0: c.id.evaluate(s.q[i], s.qd[i], s.qdd[i], c.v); break;
+      case 1: case 4: c.M.evaluate(s.q[i], c.H); break;
+      case 2: c.fd.evaluate(s.q[i], s.qd[i], s.tau[i], c.a); break;
+      case 3: c.d.evaluate(s.q[i], s.qd[i], s.qdd[i], c.r); break;
+    }
+    asm volatile("" ::: "memory");
+  }
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+void nh_outs(void* p, const states& s, outs& o) {
+  auto& c = *static_cast<nh_ctx*>(p);
+  c.id.evaluate(s.q[0], s.qd[0], s.qdd[0], c.v); o.tau = c.v;
+  c.M.evaluate(s.q[0], c.H); o.M = c.H;
+  c.fd.evaluate(s.q[0], s.qd[0], s.tau[0], c.a); o.qdd = c.a;
+  c.d.evaluate(s.q[0], s.qd[0], s.qdd[0], c.r); o.dq = c.r.dq; o.dv = c.r.dqd;
+}
+void nh_free(void* p) { delete static_cast<nh_ctx*>(p); }
