@@ -30,7 +30,8 @@ std::pair<mat3<T>, vec3<T>> placement(const body<S>& b, const T& q) {
 /// the unit axis u through the point c, [0; u] for a prismatic one (RBDA Table 4.1).
 template <class T, class S>
 spatial::vec6<T> motion_subspace(const body<S>& b) {
-  const mat3<T> R_BJ = b.R_JB.template cast<T>().transpose();
+  mat3<T> R_BJ = b.R_JB.template cast<T>();
+  R_BJ.transposeInPlace();  // as spatial::motion_transform's Rt (a g++ 12 warning otherwise)
   const vec3<T> u = R_BJ * b.axis.template cast<T>();
   const vec3<T> c = -(R_BJ * b.p_JB.template cast<T>());
   spatial::vec6<T> s;

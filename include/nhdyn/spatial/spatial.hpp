@@ -28,7 +28,10 @@ mat3<S> skew(const vec3<S>& v) {
 template <class S>
 mat6<S> motion_transform(const mat3<S>& R, const vec3<S>& p) {
   mat6<S> X = mat6<S>::Zero();
-  const mat3<S> Rt = R.transpose();
+  // not `const mat3<S> Rt = R.transpose()`: g++ 12 at -O1 without NDEBUG warns there
+  // (-Wmaybe-uninitialized, in Eigen's aliasing check)
+  mat3<S> Rt = R;
+  Rt.transposeInPlace();
   X.template topLeftCorner<3, 3>() = Rt;
   X.template bottomRightCorner<3, 3>() = Rt;
   X.template bottomLeftCorner<3, 3>() = -Rt * skew(p);
