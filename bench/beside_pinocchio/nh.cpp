@@ -27,7 +27,7 @@ double nh_run(void* p, int algo, const states& s, long K) {
     switch (algo) {
       case 0: c.id.evaluate(s.q[i], s.qd[i], s.qdd[i], c.v); break;
       case 1: case 4: c.M.evaluate(s.q[i], c.H); break;
-      case 2: c.fd.evaluate(s.q[i], s.qd[i], s.tau[i], c.a); break;
+      case 2: case 5: c.fd.evaluate(s.q[i], s.qd[i], s.tau[i], c.a); break;
       case 3: c.d.evaluate(s.q[i], s.qd[i], s.qdd[i], c.r); break;
     }
     asm volatile("" ::: "memory");
@@ -40,5 +40,6 @@ void nh_outs(void* p, const states& s, outs& o) {
   c.M.evaluate(s.q[0], c.H); o.M = c.H;
   c.fd.evaluate(s.q[0], s.qd[0], s.tau[0], c.a); o.qdd = c.a;
   c.d.evaluate(s.q[0], s.qd[0], s.qdd[0], c.r); o.dq = c.r.dq; o.dv = c.r.dqd;
+  o.tau_d = c.r.tau; o.M_d = c.r.M;
 }
 void nh_free(void* p) { delete static_cast<nh_ctx*>(p); }

@@ -3,13 +3,18 @@
 # the build, the tests or CI:
 #   bench/beside_pinocchio/run.sh <Pinocchio source tree> <example-robot-data source tree> [blocks]
 # Builds the harness by g++ and by clang++-14 in build-beside-pinocchio/ (-O3 -march=native
-# -DNDEBUG; nhdyn's files under clang also with -ffp-contract=fast, as the nhdyn CMake target
-# gives it), runs both (their output: build-beside-pinocchio/<compiler>.txt) and prints the table
-# of docs/performance.md (table.py). Pinocchio is used header-only, compiled with the harness's
-# flags (no PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION; -w: g++ 12 warns inside its joint code);
-# the three headers its CMake would generate are written below. Needs Eigen, Boost's headers,
-# urdfdom and tinyxml2 (the project's own dependencies).
+# -DNDEBUG; under clang also -ffp-contract=fast, which the nhdyn CMake target gives every file of
+# a program that links it, so Pinocchio's file gets it too), runs both (their output:
+# build-beside-pinocchio/<compiler>.txt) and prints the table of docs/performance.md (table.py).
+# Pinocchio is used header-only, compiled with the harness's flags (no
+# PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION; -w: g++ 12 warns inside its joint code); the three
+# headers its CMake would generate are written below. Needs Eigen, Boost's headers, urdfdom and
+# tinyxml2 (the project's own dependencies).
 set -euo pipefail
+if [ $# -lt 2 ]; then
+  echo "usage: $0 <Pinocchio source tree> <example-robot-data source tree> [blocks = 21]" >&2
+  exit 2
+fi
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 pin=$(cd "$1" && pwd)
@@ -48,7 +53,7 @@ for cxx in g++ clang++-14; do
   nh=(); [[ $cxx == clang* ]] && nh=(-ffp-contract=fast)
   "$cxx" "${flags[@]}" "${nh[@]}" -I"$root/include" -I"$root/tests" -c "$here/nh.cpp" -o "$dir/nh.o"
   "$cxx" "${flags[@]}" "${nh[@]}" -I"$root/include" -I"$root/tests" "-DNHDYN_SOURCE_DIR=\"$root\"" -c "$here/main.cpp" -o "$dir/main.o"
-  "$cxx" "${flags[@]}" -w -isystem "$out/gen" -isystem "$pin/include" -I"$root/include" -c "$here/pin.cpp" -o "$dir/pin.o"
+  "$cxx" "${flags[@]}" "${nh[@]}" -w -isystem "$out/gen" -isystem "$pin/include" -I"$root/include" -c "$here/pin.cpp" -o "$dir/pin.o"
   "$cxx" "$dir/main.o" "$dir/nh.o" "$dir/pin.o" -o "$dir/harness" -lurdfdom_model -ltinyxml2 -lconsole_bridge
 done
 for cxx in g++ clang++-14; do

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The markdown table of docs/performance.md, "Beside Pinocchio", from the harness's output under
 g++ and under clang (run.sh runs it): nhdyn's time / Pinocchio's, the median of the paired
-blocks; for CRBA against the convention (LOCAL or WORLD) in which Pinocchio was faster."""
+blocks; for CRBA and ABA against the convention (LOCAL or WORLD) in which Pinocchio was faster."""
 import re
 import sys
 
@@ -24,9 +24,9 @@ def parse(path):
 
 
 def ratio(d, algo):
-    if algo != 'crba':
+    if algo not in ('crba', 'aba'):
         return d[algo][1]
-    local, world = d['crba_local'], d['crba_world']
+    local, world = d[algo + '_local'], d[algo + '_world']
     return (local if local[0] <= world[0] else world)[1]
 
 
