@@ -6,6 +6,7 @@
 /// derivatives, and times the two in alternating blocks.
 #pragma once
 #include <Eigen/Core>
+#include <chrono>
 #include <vector>
 #include <nhdyn/model/tree.hpp>
 struct states { int n; std::vector<Eigen::VectorXd> q, qd, qdd, tau; };
@@ -22,3 +23,15 @@ void pin_outs(void* c, const states& s, outs& o);
 void pin_free(void* c);
 // algo: 0 rne, 1 crba, 2 aba, 3 rne derivatives; 4 crba and 5 aba (Pinocchio: 1 and 2 in the
 // LOCAL convention, 4 and 5 in the WORLD one; nhdyn has one of each)
+
+/// Seconds for K calls of call(i), i cycling through the 64 states; each library's file runs
+/// its own loop (no call between the files inside it).
+template <class F>
+double time_calls(long K, const F& call) {
+  const auto t0 = std::chrono::steady_clock::now();
+  for (long k = 0; k < K; ++k) {
+    call(int(k & 63));
+    asm volatile("" ::: "memory");
+  }
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}

@@ -47,9 +47,11 @@ int main(int argc, char** argv) {
   for (const char* f : {"mobile_manipulator", "powered_castors_arm", "tiago_style"})
     models.emplace_back(f, nhdyn::io::load_urdf(std::string(NHDYN_SOURCE_DIR "/examples/urdf/") + f + ".urdf"));
   std::mt19937_64 tree_rng(41);  // the benchmark's trees (bench/nhdyn_bench.cpp)
-  for (int n : {12, 24, 48, 96}) models.emplace_back("tree" + std::to_string(n), dfs_order(nhdyn_ref::random_tree(tree_rng, n, 0.4, false)));
+  for (int n : {12, 24, 48, 96})
+    models.emplace_back("tree" + std::to_string(n), dfs_order(nhdyn_ref::random_tree(tree_rng, n, 0.4, false)));
   const char* names[] = {"rne", "crba", "aba", "rne_derivatives", "crba", "aba"};
-  std::printf("ns per call, medians of %d paired blocks of about 1 ms each (64 states); ratio = nhdyn / Pinocchio\n", blocks);
+  std::printf("ns per call, medians of %d paired blocks of about 1 ms each (64 states); "
+              "ratio = nhdyn / Pinocchio\n", blocks);
   for (auto& [name, t] : models) {
     const int n = t.dof();
     states s{n};
@@ -68,8 +70,8 @@ int main(int argc, char** argv) {
     pin_outs(b, s, ob);
     const double e[] = {rel(oa.tau, ob.tau), rel(oa.M, ob.M), rel(oa.qdd, ob.qdd), rel(oa.dq, ob.dq), rel(oa.dv, ob.dv),
                         rel(oa.tau_d, ob.tau_d), rel(oa.M_d, ob.M_d)};
-    std::printf("%s n=%d  agree (max |nhdyn - Pinocchio| / (1 + max |Pinocchio|)): tau %.1e M %.1e qdd %.1e dq %.1e dv %.1e"
-                " (derivatives' tau %.1e, M %.1e)\n",
+    std::printf("%s n=%d  agree (max |nhdyn - Pinocchio| / (1 + max |Pinocchio|)): "
+                "tau %.1e M %.1e qdd %.1e dq %.1e dv %.1e (derivatives' tau %.1e, M %.1e)\n",
                 name.c_str(), n, e[0], e[1], e[2], e[3], e[4], e[5], e[6]);
     if (!(*std::max_element(std::begin(e), std::end(e)) < 1e-9)) {
       std::printf("the two libraries disagree on %s: not timed\n", name.c_str());

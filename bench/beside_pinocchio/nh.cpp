@@ -2,7 +2,6 @@
 /// nhdyn's side: rne, CRBA, ABA and ∂τ/∂(q, q̇) into results the caller reuses (`evaluate`).
 #include <nhdyn/nhdyn.hpp>
 #include <nhdyn/dynamics/rne_derivatives.hpp>
-#include <chrono>
 #include "api.hpp"
 struct nh_ctx {
   decltype(nhdyn::rne(std::declval<nhdyn::tree<double>>())) id;
@@ -21,18 +20,14 @@ void* nh_make(const nhdyn::tree<double>& t) {
 }
 double nh_run(void* p, int algo, const states& s, long K) {
   auto& c = *static_cast<nh_ctx*>(p);
-  const auto t0 = std::chrono::steady_clock::now();
-  for (long k = 0; k < K; ++k) {
-    const int i = int(k & 63);
+  return time_calls(K, [&](int i) {
     switch (algo) {
       case 0: c.id.evaluate(s.q[i], s.qd[i], s.qdd[i], c.v); break;
       case 1: case 4: c.M.evaluate(s.q[i], c.H); break;
       case 2: case 5: c.fd.evaluate(s.q[i], s.qd[i], s.tau[i], c.a); break;
       case 3: c.d.evaluate(s.q[i], s.qd[i], s.qdd[i], c.r); break;
     }
-    asm volatile("" ::: "memory");
-  }
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  });
 }
 void nh_outs(void* p, const states& s, outs& o) {
   auto& c = *static_cast<nh_ctx*>(p);

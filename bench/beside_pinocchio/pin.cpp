@@ -9,7 +9,6 @@
 #include "pinocchio/algorithm/aba.hpp"
 #include "pinocchio/algorithm/rnea-derivatives.hpp"
 #include <Eigen/Geometry>
-#include <chrono>
 #include "api.hpp"
 struct pin_ctx { pinocchio::Model m; pinocchio::Data d; };
 static pinocchio::SE3 se3(const Eigen::Matrix3d& R, const Eigen::Vector3d& p) { return pinocchio::SE3(R, p); }
@@ -30,7 +29,8 @@ void* pin_make(const nhdyn::tree<double>& t) {
   for (int i = 0; i < n; ++i) {
     const auto& b = t[i];
     const Eigen::Vector3d u = b.axis;
-    const bool aligned = u == Eigen::Vector3d::UnitX() || u == Eigen::Vector3d::UnitY() || u == Eigen::Vector3d::UnitZ();
+    const bool aligned =
+        u == Eigen::Vector3d::UnitX() || u == Eigen::Vector3d::UnitY() || u == Eigen::Vector3d::UnitZ();
     A[i] = aligned ? Eigen::Matrix3d::Identity()
                    : Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), u).toRotationMatrix();
     const pinocchio::JointIndex parent = b.parent < 0 ? 0 : pinocchio::JointIndex(b.parent + 1);
@@ -58,9 +58,7 @@ void* pin_make(const nhdyn::tree<double>& t) {
 }
 double pin_run(void* p, int algo, const states& s, long K) {
   auto& c = *static_cast<pin_ctx*>(p);
-  const auto t0 = std::chrono::steady_clock::now();
-  for (long k = 0; k < K; ++k) {
-    const int i = int(k & 63);
+  return time_calls(K, [&](int i) {
     switch (algo) {
       case 0: pinocchio::rnea(c.m, c.d, s.q[i], s.qd[i], s.qdd[i]); break;
       case 1: pinocchio::crba(c.m, c.d, s.q[i], pinocchio::Convention::LOCAL); break;
@@ -69,9 +67,7 @@ double pin_run(void* p, int algo, const states& s, long K) {
       case 5: pinocchio::aba(c.m, c.d, s.q[i], s.qd[i], s.tau[i], pinocchio::Convention::WORLD); break;
       case 3: pinocchio::computeRNEADerivatives(c.m, c.d, s.q[i], s.qd[i], s.qdd[i]); break;
     }
-    asm volatile("" ::: "memory");
-  }
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  });
 }
 void pin_outs(void* p, const states& s, outs& o) {
   auto& c = *static_cast<pin_ctx*>(p);
