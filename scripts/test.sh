@@ -1,21 +1,49 @@
 #!/usr/bin/env bash
-# Builds and runs the whole test suite (g++, Release; the test programs, the tool, the examples
-# and the Python module at -O1: NHDYN_TEST_OPT, NHDYN_PROGRAM_OPT). With --sanitize: the
-# sanitizer set (tests/CMakeLists.txt, NHDYN_SANITIZE_SET: the code that handles memory,
-# indices and bad input; without the tool and the examples) under AddressSanitizer and
-# UndefinedBehaviorSanitizer, built by clang++-14 at -O0 with line tables in its own build folder
-# (a second compiler, and the one the fuzz targets use); --sanitize --all: every test, the tool
-# and the examples included, under the sanitizers.
+# Builds and runs the whole test suite, and the sanitizer set.
+#
+#   scripts/test.sh                    every test, the tool, the examples and the Python module,
+#                                      built by clang++-14 in build/ (Release), then ctest
+#   scripts/test.sh --sanitize         the sanitizer set (tests/CMakeLists.txt, NHDYN_SANITIZE_SET:
+#                                      the code that handles memory, indices and bad input; without
+#                                      the tool and the examples) under AddressSanitizer and
+#                                      UndefinedBehaviorSanitizer, built by g++ at -O0 with line
+#                                      tables in build-asan/
+#   scripts/test.sh --sanitize --all   every test, the tool and the examples, under the sanitizers
+#   --cxx COMPILER                     build by COMPILER instead, e.g. --cxx g++
+#
+# Two compilers, each where it costs least. CI (.ci/run) runs both passes: clang compiles and
+# runs everything, g++ the sanitizer set (the kernels, the loaders, the wheels, robot_dynamics
+# and the parsers' bad input), so the core of every change is compiled by both. clang 14 compiles the suite's instantiations in about half g++ 12's time
+# (2026-12-06, a clean build on two cores: 631 s of wall time by clang with the tests at -O0,
+# 1185 s by g++ with them at -O0 too; docs/performance.md, "CI time"), so the whole suite goes to
+# clang, and g++ builds the sanitizer set.
+# The test programs are built at NHDYN_TEST_OPT (tests/CMakeLists.txt: -O0 under clang, -O1 under
+# g++), the tool, the examples and the Python module at -O1 (NHDYN_PROGRAM_OPT).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+sanitize=0
+all=0
+cxx=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --sanitize) sanitize=1 ;;
+    --all) all=1 ;;
+    --cxx) cxx="${2:?--cxx needs a compiler, e.g. --cxx g++}"; shift ;;
+    *) echo "scripts/test.sh: unknown option '$1' (--sanitize, --all, --cxx COMPILER)" >&2; exit 2 ;;
+  esac
+  shift
+done
 bash scripts/install-deps.sh
 targets=()
 select=()
-if [ "${1:-}" = "--sanitize" ]; then
+if [ "$sanitize" = 1 ]; then
   dir=build-asan
-  extra=(-DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=None "-DCMAKE_CXX_FLAGS=-O0 -gline-tables-only"
+  cxx=${cxx:-g++}
+  # line tables for the sanitizers' reports: -gline-tables-only (clang), -g1 (g++)
+  case "$("$cxx" --version | head -1)" in *clang*) lines=-gline-tables-only ;; *) lines=-g1 ;; esac
+  extra=(-DCMAKE_BUILD_TYPE=None "-DCMAKE_CXX_FLAGS=-O0 $lines"
          -DNHDYN_TEST_OPT= -DNHDYN_PROGRAM_OPT= -DNHDYN_SANITIZE=address,undefined)
-  if [ "${2:-}" != "--all" ]; then
+  if [ "$all" = 0 ]; then
     extra+=(-DNHDYN_BUILD_EXAMPLES=OFF)
     targets=(--target nhdyn_sanitize_set)
     select=(-L sanitize)
@@ -26,9 +54,21 @@ if [ "${1:-}" = "--sanitize" ]; then
   export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1}
 else
   dir=build
+  cxx=${cxx:-clang++-14}
   extra=(-DCMAKE_BUILD_TYPE=Release -DNHDYN_PROGRAM_OPT=-O1 -DNHDYN_BUILD_EXAMPLES=ON)
 fi
-cmake -S . -B "$dir" -DNHDYN_BUILD_TESTS=ON "${extra[@]}" >/dev/null
+cxx_path=$(command -v "$cxx") || { echo "scripts/test.sh: compiler '$cxx' not found" >&2; exit 2; }
+# A build folder configured by another compiler starts again from an empty cache (CMake keeps
+# the first compiler it found in a folder; compared as real paths: /usr/bin/c++ is g++-12).
+if [ -f "$dir/CMakeCache.txt" ]; then
+  cached=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$dir/CMakeCache.txt")
+  if [ -n "$cached" ] && [ "$(realpath -e "$cached" 2>/dev/null)" != "$(realpath -e "$cxx_path")" ]; then
+    echo "test.sh: $dir was configured by $cached; configuring it again for $cxx"
+    rm -rf "$dir/CMakeCache.txt" "$dir/CMakeFiles"
+  fi
+fi
+cmake -S . -B "$dir" -DCMAKE_CXX_COMPILER="$cxx" -DNHDYN_BUILD_TESTS=ON "${extra[@]}" >/dev/null
+echo "test.sh: $dir, $("$cxx" --version | head -1)"
 t0=$SECONDS
 cmake --build "$dir" -j"$(nproc)" "${targets[@]}"
 echo "test.sh: $dir built in $(( SECONDS - t0 )) s"
