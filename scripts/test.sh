@@ -13,12 +13,12 @@
 #
 # Two compilers, each where it costs least. CI (.ci/run) runs both passes: clang compiles and
 # runs everything, g++ the sanitizer set (the kernels, the loaders, the wheels, robot_dynamics
-# and the parsers' bad input), so the core of every change is compiled by both. clang 14 compiles the suite's instantiations in about half g++ 12's time
-# (2026-12-06, a clean build on two cores: 631 s of wall time by clang with the tests at -O0,
-# 1185 s by g++ with them at -O0 too; docs/performance.md, "CI time"), so the whole suite goes to
-# clang, and g++ builds the sanitizer set.
-# The test programs are built at NHDYN_TEST_OPT (tests/CMakeLists.txt: -O0 under clang, -O1 under
-# g++), the tool, the examples and the Python module at -O1 (NHDYN_PROGRAM_OPT).
+# and the parsers' bad input), so the core of every change is compiled by both. clang 14
+# compiles the suite's instantiations in about half g++ 12's time (2026-12-06, clean builds on
+# two cores one after the other: 631 s of wall time by clang with the tests at -O0, 1185 s by
+# g++ with them at -O0 too; docs/performance.md, "CI time"). The test programs are built at
+# NHDYN_TEST_OPT (tests/CMakeLists.txt: -O0 under clang, -O1 under g++), the tool, the examples
+# and the Python module at -O1 (NHDYN_PROGRAM_OPT).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 sanitize=0
@@ -33,12 +33,17 @@ while [ $# -gt 0 ]; do
   esac
   shift
 done
+if [ "$all" = 1 ] && [ "$sanitize" = 0 ]; then
+  echo "scripts/test.sh: --all goes with --sanitize (the Release pass builds everything)" >&2
+  exit 2
+fi
+[ "$sanitize" = 1 ] && cxx=${cxx:-g++} || cxx=${cxx:-clang++-14}
+cxx_path=$(command -v "$cxx") || { echo "scripts/test.sh: compiler '$cxx' not found" >&2; exit 2; }
 bash scripts/install-deps.sh
 targets=()
 select=()
 if [ "$sanitize" = 1 ]; then
   dir=build-asan
-  cxx=${cxx:-g++}
   # line tables for the sanitizers' reports: -gline-tables-only (clang), -g1 (g++)
   case "$("$cxx" --version | head -1)" in *clang*) lines=-gline-tables-only ;; *) lines=-g1 ;; esac
   extra=(-DCMAKE_BUILD_TYPE=None "-DCMAKE_CXX_FLAGS=-O0 $lines"
@@ -54,20 +59,20 @@ if [ "$sanitize" = 1 ]; then
   export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1}
 else
   dir=build
-  cxx=${cxx:-clang++-14}
   extra=(-DCMAKE_BUILD_TYPE=Release -DNHDYN_PROGRAM_OPT=-O1 -DNHDYN_BUILD_EXAMPLES=ON)
 fi
-cxx_path=$(command -v "$cxx") || { echo "scripts/test.sh: compiler '$cxx' not found" >&2; exit 2; }
 # A build folder configured by another compiler starts again from an empty cache (CMake keeps
 # the first compiler it found in a folder; compared as real paths: /usr/bin/c++ is g++-12).
 if [ -f "$dir/CMakeCache.txt" ]; then
   cached=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$dir/CMakeCache.txt")
-  if [ -n "$cached" ] && [ "$(realpath -e "$cached" 2>/dev/null)" != "$(realpath -e "$cxx_path")" ]; then
-    echo "test.sh: $dir was configured by $cached; configuring it again for $cxx"
+  cached_path=$(command -v "$cached" 2>/dev/null || true)
+  if [ -n "$cached" ] &&
+     [ "$(realpath -e "$cached_path" 2>/dev/null)" != "$(realpath -e "$cxx_path")" ]; then
+    echo "test.sh: $dir was configured by $cached; configuring it again for $cxx_path"
     rm -rf "$dir/CMakeCache.txt" "$dir/CMakeFiles"
   fi
 fi
-cmake -S . -B "$dir" -DCMAKE_CXX_COMPILER="$cxx" -DNHDYN_BUILD_TESTS=ON "${extra[@]}" >/dev/null
+cmake -S . -B "$dir" -DCMAKE_CXX_COMPILER="$cxx_path" -DNHDYN_BUILD_TESTS=ON "${extra[@]}" >/dev/null
 echo "test.sh: $dir, $("$cxx" --version | head -1)"
 t0=$SECONDS
 cmake --build "$dir" -j"$(nproc)" "${targets[@]}"
