@@ -40,12 +40,13 @@ fi
 bash scripts/install-deps.sh  # installs g++ and clang-14 too, so look for the compiler after it
 [ "$sanitize" = 1 ] && cxx=${cxx:-g++} || cxx=${cxx:-clang++-14}
 cxx_path=$(command -v "$cxx") || { echo "scripts/test.sh: compiler '$cxx' not found" >&2; exit 2; }
+cxx_version=$("$cxx_path" --version | head -1)
 targets=()
 select=()
 if [ "$sanitize" = 1 ]; then
   dir=build-asan
   # line tables for the sanitizers' reports: -gline-tables-only (clang), -g1 (g++)
-  case "$("$cxx" --version | head -1)" in *clang*) lines=-gline-tables-only ;; *) lines=-g1 ;; esac
+  case "$cxx_version" in *clang*) lines=-gline-tables-only ;; *) lines=-g1 ;; esac
   extra=(-DCMAKE_BUILD_TYPE=None "-DCMAKE_CXX_FLAGS=-O0 $lines"
          -DNHDYN_TEST_OPT= -DNHDYN_PROGRAM_OPT= -DNHDYN_SANITIZE=address,undefined)
   if [ "$all" = 0 ]; then
@@ -73,7 +74,7 @@ if [ -f "$dir/CMakeCache.txt" ]; then
   fi
 fi
 cmake -S . -B "$dir" -DCMAKE_CXX_COMPILER="$cxx_path" -DNHDYN_BUILD_TESTS=ON "${extra[@]}" >/dev/null
-echo "test.sh: $dir, $("$cxx" --version | head -1)"
+echo "test.sh: $dir, $cxx_version"
 t0=$SECONDS
 cmake --build "$dir" -j"$(nproc)" "${targets[@]}"
 echo "test.sh: $dir built in $(( SECONDS - t0 )) s"
