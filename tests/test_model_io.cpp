@@ -12,6 +12,8 @@
 #include <nhdyn/nhdyn.hpp>
 #include <random>
 
+#include "support/scratch_dir.hpp"
+
 namespace fs = std::filesystem;
 using nhdyn::io::json;
 
@@ -27,14 +29,7 @@ std::string read_text(const fs::path& p) {
 }
 
 /// A scratch directory for this test binary's files.
-fs::path scratch() {
-  static const fs::path dir = [] {
-    auto d = fs::temp_directory_path() / ("nhdyn_test_model_io_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
+fs::path scratch() { return nhdyn_test::scratch_dir("model_io"); }
 
 template <class S, int N, int M>
 void require_same_chain(const nhdyn::chain<S, N>& a, const nhdyn::chain<S, M>& b) {

@@ -15,6 +15,8 @@
 #include <nhdyn/version.hpp>
 #include <sstream>
 
+#include "../support/scratch_dir.hpp"
+
 namespace fs = std::filesystem;
 using nhdyn::io::json;
 using Eigen::MatrixXd;
@@ -24,14 +26,7 @@ namespace {
 
 fs::path source_dir() { return NHDYN_SOURCE_DIR; }
 
-fs::path scratch() {
-  static const fs::path dir = [] {
-    auto d = fs::temp_directory_path() / ("nhdyn_test_tool_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
+fs::path scratch() { return nhdyn_test::scratch_dir("tool"); }
 
 std::string read_text(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);

@@ -21,6 +21,8 @@
 #include <regex>
 #include <sstream>
 
+#include "../support/scratch_dir.hpp"
+
 namespace fs = std::filesystem;
 using nhdyn::io::json;
 
@@ -33,8 +35,7 @@ struct run_result {
 
 run_result run_tool(const std::string& args, const std::string& input) {
   static int count = 0;
-  const auto dir = fs::temp_directory_path() / ("nhdyn_test_lb_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const auto& dir = nhdyn_test::scratch_dir("lb");
   const auto base = (dir / ("run" + std::to_string(++count))).string();
   std::ofstream(base + ".in", std::ios::binary) << input;
   const std::string cmd = std::string("'") + NHDYN_TOOL_PATH + "' " + args + " < '" + base + ".in' > '" + base +

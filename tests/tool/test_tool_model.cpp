@@ -18,6 +18,8 @@
 #include <random>
 #include <sstream>
 
+#include "../support/scratch_dir.hpp"
+
 namespace fs = std::filesystem;
 using nhdyn::io::json;
 using Eigen::VectorXd;
@@ -34,8 +36,7 @@ struct run_result {
 
 run_result run_tool(const std::string& args, const std::string& input = "") {
   static int count = 0;
-  const auto dir = fs::temp_directory_path() / ("nhdyn_test_tool_model_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const auto& dir = nhdyn_test::scratch_dir("tool_model");
   const auto base = (dir / ("run" + std::to_string(++count))).string();
   std::ofstream(base + ".in", std::ios::binary) << input;
   const std::string cmd = std::string("'") + NHDYN_TOOL_PATH + "' " + args + " < '" + base + ".in' > '" + base +
@@ -375,7 +376,7 @@ TEST_CASE("tool: --lock on DH models (presets, JSON models): the chain's kept en
   // joint 4: its η is (v, ω, q̇5) and τ the full chain's entries for them
   auto m = nhdyn::io::load("paper5");
   m.locked = {{"joint4", 0.6}};
-  const auto file = fs::temp_directory_path() / ("nhdyn_test_tool_p5_locked_" + std::to_string(::getpid()) + ".json");
+  const auto file = nhdyn_test::scratch_dir("tool_model") / "p5_locked.json";
   nhdyn::io::save_model(m, file);
   VectorXd q5 = rand(5), eta = rand(4), eta_dot = rand(4);
   q5(3) = 0.6, eta(2) = eta_dot(2) = 0;  // η = (v, ω, q̇4, q̇5)

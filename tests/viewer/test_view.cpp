@@ -21,6 +21,8 @@
 #include <nhdyn/kinematics/tree.hpp>
 #include <sstream>
 
+#include "../support/scratch_dir.hpp"
+
 namespace fs = std::filesystem;
 using nhdyn::io::json;
 
@@ -44,7 +46,7 @@ run_result shell(const std::string& cmd, const fs::path& dir, const std::string&
   return r;
 }
 fs::path scratch(const std::string& name) {
-  const auto d = fs::temp_directory_path() / ("nhdyn_test_view_" + std::to_string(::getpid())) / name;
+  const auto d = nhdyn_test::scratch_dir("view") / name;
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
