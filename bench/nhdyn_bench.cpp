@@ -12,6 +12,8 @@
 ///   crba/<tree>/{nhdyn, reference}               spatial-algebra reference, KDL's tree solver);
 ///   {rne, crba, aba}/<tree>/evaluate            the kernels into a result the caller reuses;
 ///   crba_pair/<tree>                             rne and CRBA evaluate paired (ratio CRBA / rne);
+///   crba/<tree>/kept, crba_pair_kept/<tree>      CRBA into a mass_matrix_result (the tree's zeros
+///                                                kept from call to call), alone and paired with rne;
 ///   aba/<tree>/nhdyn                            ABA on the tree (a returned q̈)
 ///   fd/<model>/{aba, aba_reference, crba_ldlt, crba_ldlt_evaluate, kdl}  holonomic forward
 ///                                               dynamics: the articulated-body algorithm (kernel,
@@ -440,30 +442,36 @@ void register_tree(const std::string& model, const nhdyn::tree<double>& t) {
     M.evaluate(s.q, Hm);
     agree(Eigen::Map<const Eigen::VectorXd>(Hm.data(), n * n), Eigen::Map<const Eigen::VectorXd>(M(s.q).eval().data(), n * n), 0,
           "crba/" + model + ": evaluate vs the call");
-    add("rne/" + model + "/evaluate", [id, s, v]() mutable {
+    // each case's own copy of the function object, state and storage
+    const auto rne_evaluate = [id, s, v]() mutable {
       opaque(s.q), opaque(s.qd), opaque(s.qdd);
       id.evaluate(s.q, s.qd, s.qdd, v);
       benchmark::DoNotOptimize(v.data());
-    });
-    add("crba/" + model + "/evaluate", [M, s, Hm]() mutable {
-      opaque(s.q);
-      M.evaluate(s.q, Hm);
-      benchmark::DoNotOptimize(Hm.data());
-    });
+    };
+    const auto crba_evaluate = [M, s](auto out) {  // into a matrix, or a mass_matrix_result (kept)
+      return [M, s, out]() mutable {
+        opaque(s.q);
+        M.evaluate(s.q, out);
+        if constexpr (std::is_same_v<decltype(out), Eigen::MatrixXd>)
+          benchmark::DoNotOptimize(out.data());
+        else
+          benchmark::DoNotOptimize(out.matrix().data());
+      };
+    };
+    // the same into a mass_matrix_result, whose zeros the calls after its first keep
+    nhdyn::mass_matrix_result<double> kept;
+    M.evaluate(s.q, kept);
+    M.evaluate(s.q, kept);
+    agree(Eigen::Map<const Eigen::VectorXd>(kept.matrix().data(), n * n), Eigen::Map<const Eigen::VectorXd>(Hm.data(), n * n), 0,
+          "crba/" + model + ": kept vs evaluate");
+    add("rne/" + model + "/evaluate", rne_evaluate);
+    add("crba/" + model + "/evaluate", crba_evaluate(Hm));
+    add("crba/" + model + "/kept", crba_evaluate(kept));
     // crba_pair/<tree>: one rne and one CRBA of the same tree and state, both into reused
-    // storage, paired (ratio = CRBA / rne; issue 33's target ≤ 0.6)
-    add_paired(
-        "crba_pair/" + model,
-        [id, s, v]() mutable {
-          opaque(s.q), opaque(s.qd), opaque(s.qdd);
-          id.evaluate(s.q, s.qd, s.qdd, v);
-          benchmark::DoNotOptimize(v.data());
-        },
-        [M, s, Hm]() mutable {
-          opaque(s.q);
-          M.evaluate(s.q, Hm);
-          benchmark::DoNotOptimize(Hm.data());
-        });
+    // storage, paired (ratio = CRBA / rne; issue 33's target ≤ 0.6); crba_pair_kept/<tree>: the
+    // same with M into the mass_matrix_result
+    add_paired("crba_pair/" + model, rne_evaluate, crba_evaluate(Hm));
+    add_paired("crba_pair_kept/" + model, rne_evaluate, crba_evaluate(kept));
     // ABA (q̈ for τ = rne(q, q̇, q̈) gives q̈ back), as a call and into a reused q̈
     const auto fd = nhdyn::aba(t);
     agree(fd(s.q, s.qd, tau), s.qdd, 1e-8, "aba/" + model + ": aba inverts rne");

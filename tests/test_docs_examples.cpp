@@ -142,11 +142,21 @@ TEST_CASE("docs/api.md §2: a URDF tree: gravity torques, branch-sparse M, a mer
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(arm.dof());
   const Eigen::VectorXd g = nhdyn::rne(arm)(q, q, q);            // gravity torques
   const Eigen::MatrixXd M = nhdyn::mass_matrix(arm)(q);            // CRBA, branch-sparse
+  Eigen::VectorXd v(arm.dof());  Eigen::MatrixXd H;                // reused from call to call:
+  nhdyn::rne(arm).evaluate(q, q, q, v);                            //   no allocation (a Map works too)
+  nhdyn::mass_matrix(arm).evaluate(q, H);                          //   H sized n × n by its first call
+  nhdyn::mass_matrix_result<double> Mr;                            // M kept between calls: its zeros
+  nhdyn::mass_matrix(arm).evaluate(q, Mr);                         //   written by the first call only;
+  const Eigen::MatrixXd& M2 = Mr.matrix();                         //   read-only (see below)
   const nhdyn::tree_kinematics<double> kin(arm);
   const auto tool = kin.frame(q, "tool_frame");                    // a merged fixed link, by name
   const auto t5 = nhdyn::as_tree(nhdyn::presets::paper5_chain());  // a DH chain is a tree
   // end snippet
   CHECK(arm.dof() == 16);
+  // the evaluate forms give the calls' numbers, bit for bit
+  CHECK(v == g);
+  CHECK(H == M);
+  CHECK(M2 == M);
   // gravity torques = −Σ J_cᵀ m g, from the kinematics
   Eigen::VectorXd grav = Eigen::VectorXd::Zero(arm.dof());
   for (int i = 0; i < arm.dof(); ++i)

@@ -10,6 +10,7 @@
 #include <nhdyn/kinematics/tree.hpp>
 #include <nhdyn/nhdyn.hpp>
 #include <nhdyn/scalar/interval.hpp>
+#include <limits>
 #include <random>
 
 #include "reference/lagrangian.hpp"
@@ -135,6 +136,55 @@ TEST_CASE("tree rne and CRBA into reused storage (evaluate) give the calls' numb
     VectorXd wrong(n + 1);
     CHECK_THROWS_WITH(id.evaluate(VectorXd::Zero(n), VectorXd::Zero(n), VectorXd::Zero(n), wrong),
                       Catch::Contains("v") && Catch::Contains(std::to_string(n)));
+  }
+}
+
+TEST_CASE("tree CRBA into a mass_matrix_result: its zeros are kept, not written again, and M stays whole", "[tree]") {
+  std::mt19937_64 rng(83);
+  // two trees of 24 bodies with different branches, and one of 200 (past the kernel's stack scratch)
+  const tree<double> a = nhdyn_ref::random_tree(rng, 24), b = nhdyn_ref::random_tree(rng, 24),
+                     big = nhdyn_ref::random_tree(rng, 200);
+  const auto Ma = mass_matrix(a), Mb = mass_matrix(b), Mbig = mass_matrix(big);
+  const auto Ma_copy = Ma;  // a copy shares the tree, and so its zeros
+  // where a's M is nonzero and b's is zero by their branches: what b's first call must clear
+  const VectorXd qa = random_state(rng, 24), qb = random_state(rng, 24);
+  const MatrixXd Ha = Ma(qa), Hb = Mb(qb);
+  int stale = 0;
+  for (int i = 0; i < 24; ++i)
+    for (int j = 0; j < 24; ++j) stale += Ha(i, j) != 0 && Hb(i, j) == 0;
+  REQUIRE(stale > 0);
+  mass_matrix_result<double> r;
+  for (int s = 0; s < 3; ++s) {  // bit for bit the matrix a plain evaluate writes, call after call
+    const VectorXd q = random_state(rng, 24);
+    (s == 1 ? Ma_copy : Ma).evaluate(q, r);
+    CHECK(r.matrix() == Ma(q));
+    CHECK(rel(r.matrix(), reference::crba<double>(a, q)) < 1e-12);
+  }
+  Mb.evaluate(qb, r);  // another tree of the same size into the same result: written whole
+  CHECK(r.matrix() == Hb);
+  Mbig.evaluate(random_state(rng, 200), r);  // and of another size
+  const VectorXd qbig = random_state(rng, 200);
+  Mbig.evaluate(qbig, r);
+  CHECK(r.matrix() == Mbig(qbig));
+  // a call that throws leaves the result to be written whole by the next
+  VectorXd bad = qa;
+  bad(3) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_WITH(Ma.evaluate(bad, r), Catch::Contains("q"));
+  Ma.evaluate(qa, r);
+  CHECK(r.matrix() == Ha);
+  // intervals run the kernel-frame kernel: the same with its zeros kept
+  const tree<interval> ai = a.cast<interval>();
+  const auto Mi = mass_matrix(ai);
+  mass_matrix_result<interval> ri;
+  for (int s = 0; s < 2; ++s) {
+    const VectorXd q = random_state(rng, 24);
+    Mi.evaluate(q.cast<interval>(), ri);
+    const auto want = Mi(q.cast<interval>());
+    for (int i = 0; i < 24; ++i)
+      for (int j = 0; j < 24; ++j) {
+        CHECK(ri.matrix()(i, j).lower() == want(i, j).lower());
+        CHECK(ri.matrix()(i, j).upper() == want(i, j).upper());
+      }
   }
 }
 
