@@ -460,8 +460,8 @@ void register_tree(const std::string& model, const nhdyn::tree<double>& t) {
     };
     // the same into a mass_matrix_result, whose zeros the calls after its first keep
     nhdyn::mass_matrix_result<double> kept;
-    M.evaluate(s.q, kept);
-    M.evaluate(s.q, kept);
+    M.evaluate(Eigen::VectorXd(-s.q), kept);  // the first call, at another state, writes M whole;
+    M.evaluate(s.q, kept);                     // this one only the entries the branches make nonzero
     agree(Eigen::Map<const Eigen::VectorXd>(kept.matrix().data(), n * n), Eigen::Map<const Eigen::VectorXd>(Hm.data(), n * n), 0,
           "crba/" + model + ": kept vs evaluate");
     add("rne/" + model + "/evaluate", rne_evaluate);

@@ -145,7 +145,6 @@ TEST_CASE("tree CRBA into a mass_matrix_result: its zeros are kept, not written 
   const tree<double> a = nhdyn_ref::random_tree(rng, 24), b = nhdyn_ref::random_tree(rng, 24),
                      big = nhdyn_ref::random_tree(rng, 200);
   const auto Ma = mass_matrix(a), Mb = mass_matrix(b), Mbig = mass_matrix(big);
-  const auto Ma_copy = Ma;  // a copy shares the tree, and so its zeros
   // where a's M is nonzero and b's is zero by their branches: what b's first call must clear
   const VectorXd qa = random_state(rng, 24), qb = random_state(rng, 24);
   const MatrixXd Ha = Ma(qa), Hb = Mb(qb);
@@ -156,7 +155,7 @@ TEST_CASE("tree CRBA into a mass_matrix_result: its zeros are kept, not written 
   mass_matrix_result<double> r;
   for (int s = 0; s < 3; ++s) {  // bit for bit the matrix a plain evaluate writes, call after call
     const VectorXd q = random_state(rng, 24);
-    (s == 1 ? Ma_copy : Ma).evaluate(q, r);
+    (s == 1 ? mass_matrix(a) : Ma).evaluate(q, r);  // (another function object of the same tree)
     CHECK(r.matrix() == Ma(q));
     CHECK(rel(r.matrix(), reference::crba<double>(a, q)) < 1e-12);
   }
@@ -166,12 +165,23 @@ TEST_CASE("tree CRBA into a mass_matrix_result: its zeros are kept, not written 
   const VectorXd qbig = random_state(rng, 200);
   Mbig.evaluate(qbig, r);
   CHECK(r.matrix() == Mbig(qbig));
-  // a call that throws leaves the result to be written whole by the next
+  // a call that throws does so before it writes: the result keeps the last M
+  Ma.evaluate(qa, r);
   VectorXd bad = qa;
   bad(3) = std::numeric_limits<double>::quiet_NaN();
   CHECK_THROWS_WITH(Ma.evaluate(bad, r), Catch::Contains("q"));
-  Ma.evaluate(qa, r);
   CHECK(r.matrix() == Ha);
+  // a moved-from result is written whole by its next call, whatever storage the move left it
+  mass_matrix_result<double> ra, rb;
+  Ma.evaluate(qa, ra);
+  Mb.evaluate(qb, rb);
+  ra = std::move(rb);  // Eigen swaps the storage: rb may now hold a's M
+  CHECK(ra.matrix() == Hb);
+  Mb.evaluate(qb, rb);
+  CHECK(rb.matrix() == Hb);
+  mass_matrix_result<double> rc(std::move(ra));
+  Ma.evaluate(qa, rc);  // b's zeros in rc: a's call writes M whole
+  CHECK(rc.matrix() == Ha);
   // intervals run the kernel-frame kernel: the same with its zeros kept
   const tree<interval> ai = a.cast<interval>();
   const auto Mi = mass_matrix(ai);

@@ -33,7 +33,8 @@ double nh_run(void* p, int algo, const states& s, long K) {
 void nh_outs(void* p, const states& s, outs& o) {
   auto& c = *static_cast<nh_ctx*>(p);
   c.id.evaluate(s.q[0], s.qd[0], s.qdd[0], c.v); o.tau = c.v;
-  c.M.evaluate(s.q[0], c.H); o.M = c.H.matrix();  // (the zeros of the timed calls' first call)
+  c.M.evaluate(s.q[1], c.H);  // the first call writes M whole, the second (checked) keeps its zeros
+  c.M.evaluate(s.q[0], c.H); o.M = c.H.matrix();
   c.fd.evaluate(s.q[0], s.qd[0], s.tau[0], c.a); o.qdd = c.a;
   c.d.evaluate(s.q[0], s.qd[0], s.qdd[0], c.r); o.dq = c.r.dq; o.dv = c.r.dqd;
   o.tau_d = c.r.tau; o.M_d = c.r.M;

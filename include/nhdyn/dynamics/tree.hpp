@@ -16,8 +16,7 @@
 /// (tree_crba_kernel_world); for intervals, duals and multiprecision numbers in the kernel
 /// frames (tree_crba_kernel_local).
 #include <Eigen/Core>
-#include <atomic>
-#include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "../detail/attributes.hpp"
@@ -412,11 +411,6 @@ NHDYN_FLATTEN void tree_crba_kernel_flat(const std::vector<tree_link<T>>& L, con
   tree_crba_kernel_world<T>(L, K, q, H, zero_fill);
 }
 
-/// A new id for each mass_matrix(tree) built: which tree's zeros a mass_matrix_result holds.
-inline std::uint64_t next_crba_pattern() {
-  static std::atomic<std::uint64_t> last{0};
-  return ++last;
-}
 
 }  // namespace detail
 
@@ -547,23 +541,37 @@ tree_rne_fn<S> rne(const tree<S>& t, rne_options o = {}) {
 }
 
 /// M(q) of a tree, kept from call to call: `mass_matrix(t).evaluate(q, r)`, then `r.matrix()`.
-/// A tree's M is zero wherever neither body is the other's ancestor, at every q. The first
-/// call into r writes all of M; the next calls by the same `mass_matrix(t)` (or a copy of it)
-/// write only the entries its branches can make nonzero, and the zeros stay. What that saves is
-/// the zero fill of n × n entries: 0.1 µs at n = 48 and 1.5 µs at n = 96, where M no longer fits
-/// the L1 cache (docs/performance.md, note 31). The matrix is read-only, so that nothing can
-/// spoil its zeros; to factor M in place, use `evaluate(q, H)` into a matrix of your own.
-/// Pinocchio's `Data::M` keeps its zeros the same way.
+/// A tree's M is zero wherever neither body is the other's ancestor, at every q: its zeros
+/// depend on the parent of each body only. The first call into r writes all of M and keeps the
+/// tree's parents beside it; the next calls by a tree with the same parents (compared, n
+/// integers) write only the entries the branches can make nonzero, and the zeros stay. What
+/// that saves is the zero fill of n × n entries: 0.1 µs at n = 48 and 1.5 µs at n = 96, where M
+/// no longer fits the L1 cache (docs/performance.md, note 31). The matrix is read-only, so that
+/// nothing can spoil its zeros; to factor M in place, use `evaluate(q, H)` into a matrix of your
+/// own. Pinocchio's `Data::M` keeps its zeros the same way.
 template <class T>
 class mass_matrix_result {
  public:
+  mass_matrix_result() = default;
+  mass_matrix_result(const mass_matrix_result&) = default;
+  mass_matrix_result& operator=(const mass_matrix_result&) = default;
+  /// A moved-from result is written whole by its next call (Eigen's move may swap storage).
+  mass_matrix_result(mass_matrix_result&& o) noexcept : H_(std::move(o.H_)), parents_(std::move(o.parents_)) {
+    o.parents_.clear();
+  }
+  mass_matrix_result& operator=(mass_matrix_result&& o) noexcept {
+    H_ = std::move(o.H_);
+    parents_ = std::move(o.parents_);
+    o.parents_.clear();
+    return *this;
+  }
   const Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>& matrix() const { return H_; }
 
  private:
   template <class>
   friend class tree_mass_matrix_fn;
   Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> H_;
-  std::uint64_t pattern_ = 0;  ///< the mass_matrix(t) whose zeros H_ holds (0: none)
+  std::vector<int> parents_;  ///< the parents of the tree whose zeros H_ holds (empty: none)
 };
 
 /// M(q) of a tree by the composite-rigid-body algorithm: `mass_matrix(t)(q)`.
@@ -571,8 +579,10 @@ template <class S>
 class tree_mass_matrix_fn : public stage_tag {
  public:
   explicit tree_mass_matrix_fn(const tree<S>& t)
-      : links_(detail::make_tree_links(t)), n_(t.dof()), pattern_(detail::next_crba_pattern()) {
+      : links_(detail::make_tree_links(t)), n_(t.dof()) {
     if constexpr (flatten_kernels<S>) consts_ = detail::make_crba_constants(links_);  // the world-axes kernel's only
+    parents_.reserve(links_.size());
+    for (const auto& k : links_) parents_.push_back(k.parent);
   }
   int dof() const { return n_; }
 
@@ -588,14 +598,15 @@ class tree_mass_matrix_fn : public stage_tag {
   void evaluate(const Eigen::MatrixBase<Q>& q, Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>& H) const {
     run(q, H, true);
   }
-  /// M(q) into r, writing only the entries the branches can make nonzero when r holds this
-  /// tree's zeros from an earlier call (mass_matrix_result); no allocation after r's first call.
+  /// M(q) into r, writing only the entries the branches can make nonzero when r holds the
+  /// zeros of a tree with these parents from an earlier call (mass_matrix_result); no
+  /// allocation after r's first call.
   template <class Q, class T>
   void evaluate(const Eigen::MatrixBase<Q>& q, mass_matrix_result<T>& r) const {
-    const bool fill = r.pattern_ != pattern_ || r.H_.rows() != n_ || r.H_.cols() != n_;
-    r.pattern_ = 0;  // until M is whole again (run checks q first, and may throw)
+    const bool fill = r.parents_ != parents_ || r.H_.rows() != n_ || r.H_.cols() != n_;
+    if (fill) r.parents_.clear();  // until M is whole (run checks q before it writes, and may throw)
     run(q, r.H_, fill);
-    r.pattern_ = pattern_;
+    if (fill) r.parents_ = parents_;
   }
 
  private:
@@ -620,7 +631,7 @@ class tree_mass_matrix_fn : public stage_tag {
   std::vector<detail::tree_link<S>> links_;
   detail::crba_constants<S> consts_;
   int n_;
-  std::uint64_t pattern_;  ///< detail::next_crba_pattern(): copies share it, as they share the tree
+  std::vector<int> parents_;  ///< each body's parent: what decides M's zeros (mass_matrix_result)
 };
 
 template <class S>
