@@ -276,7 +276,8 @@ def tables(ctx, med, allocs, reps, cpu, compiler):
                "evaluate}`: the articulated-body forward dynamics, the same two ways. CRBA / rne: the two "
                "calls' medians (not paired); paired: `crba_pair/<tree>`, the two `evaluate` forms timed in "
                "alternating blocks on the same state; kept: `crba_pair_kept/<tree>`, the same with M into a "
-               "`mass_matrix_result`, whose zeros the calls after its first keep (not written again). The trees are the shipped mobile manipulator's URDF, the "
+               "`mass_matrix_result`, whose zeros the calls after its first keep (not written again). "
+               "The trees are the shipped mobile manipulator's URDF, the "
                "project's PR2-style (`powered_castors_arm.urdf`) and TIAGo-style (`tiago_style.urdf`: "
                "a five-finger hand) files, and random branching trees.\n")
     out.append("| tree | bodies | rne nhdyn | rne reference | rne KDL | nhdyn / KDL | CRBA nhdyn | CRBA reference | CRBA / rne | "

@@ -5,7 +5,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <functional>
-#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <nhdyn/io/json.hpp>

@@ -411,7 +411,6 @@ NHDYN_FLATTEN void tree_crba_kernel_flat(const std::vector<tree_link<T>>& L, con
   tree_crba_kernel_world<T>(L, K, q, H, zero_fill);
 }
 
-
 }  // namespace detail
 
 /// rne over a tree: `rne(t)(q, qd, qdd)` (see dynamics/rne.hpp for the meaning and options).
