@@ -14,9 +14,8 @@
 # Two compilers: clang for the suite, where it halves the build; g++ for the sanitizer set (the
 # kernels, the loaders, the wheels, robot_dynamics and the parsers' bad input; at 2.8 times
 # clang's cost there), so that both compile the core of every change. CI (.ci/run) runs both
-# passes. clang 14 compiles the suite in about half g++ 12's time (2026-12-06, clean builds on
-# two cores one after the other: 631 s of wall time by clang with the tests at -O0, 1185 s by
-# g++ with them at -O0 too; docs/performance.md, "CI time"). The test programs are built at
+# passes. clang 14 compiles the suite in about half g++ 12's time (clean builds measured on
+# 2026-12-06: docs/performance.md, "CI time"). The test programs are built at
 # NHDYN_TEST_OPT (tests/CMakeLists.txt: -O0 under clang, -O1 under g++), the tool, the examples
 # and the Python module at -O1 (NHDYN_PROGRAM_OPT).
 set -euo pipefail
