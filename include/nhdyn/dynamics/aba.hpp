@@ -35,6 +35,7 @@
 #include "../detail/small_buffer.hpp"
 #include "../errors.hpp"
 #include "../functional/values.hpp"
+#include "../model/floating.hpp"
 #include "../model/tree_kernel.hpp"
 #include "../spatial/spatial.hpp"
 #include "reference.hpp"
@@ -256,11 +257,14 @@ void tree_aba_kernel(const std::vector<tree_link<LS>>& L, const vec3<T>& g, cons
 template <class S>
 class aba_fn : public stage_tag {
  public:
-  explicit aba_fn(const tree<S>& t) : links_(detail::make_tree_links(t)), g_(t.gravity()), name_(t.name()) {
+  explicit aba_fn(const tree<S>& t)
+      : links_(detail::make_tree_links(t)), g_(t.gravity()), name_(t.name()), floating_(t.floating()) {
     joints_.reserve(static_cast<std::size_t>(t.dof()));
     for (int i = 0; i < t.dof(); ++i) joints_.push_back(t[i].joint_name);
   }
   int dof() const { return static_cast<int>(links_.size()); }
+  /// q's entries: dof() + 1 for a floating tree (model/floating.hpp), else dof().
+  int nq() const { return dof() + (floating_ ? 1 : 0); }
 
   template <class Q, class QD, class TAU>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
@@ -283,7 +287,10 @@ class aba_fn : public stage_tag {
                   "qdd's scalar is the model's and the inputs' promoted scalar");
     const int n = dof();
     detail::check_size(qdd, n, "qdd");
-    detail::check_size(q, n, "q");
+    if (floating_)
+      detail::check_floating_configuration(q, n + 1, "q");
+    else
+      detail::check_size(q, n, "q");
     detail::check_size(qd, n, "qd");
     detail::check_size(tau, n, "tau");
     detail::check_finite(q, "q");
@@ -298,7 +305,9 @@ class aba_fn : public stage_tag {
       if (std::isfinite(d) && d > 0 && d * d > tol * tol * u2 * s2) return;
       refuse(i, d, std::sqrt(u2 * s2));
     };
-    if constexpr (std::is_same_v<T, S>) {
+    if (floating_) {
+      evaluate_floating(q, qd, tau, qdd, check);
+    } else if constexpr (std::is_same_v<T, S>) {
       detail::tree_aba_kernel<T>(links_, g_, q, qd, tau, qdd, check);
     } else {
       detail::tree_aba_kernel<T>(detail::cast_links<T>(links_), vec3<T>(g_.template cast<T>()), q, qd, tau, qdd,
@@ -333,6 +342,25 @@ class aba_fn : public stage_tag {
   }
 
  private:
+  /// A floating tree: the fixed-base tree in the root's frame (model/floating.hpp) gives
+  /// q̈_K; a = q̈_K + (b(v), 0). b is taken before the kernel writes q̈ (which may be q̇'s storage).
+  template <class Q, class QD, class TAU, class QDD, class Check>
+  void evaluate_floating(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
+                         const Eigen::MatrixBase<TAU>& tau, Eigen::MatrixBase<QDD>& qdd, const Check& check) const {
+    using T = typename QDD::Scalar;
+    const int n = dof();
+    detail::small_buffer<T, dynamic> qk_s(n);
+    Eigen::Map<vecN<T, dynamic>> qk(qk_s.data(), n);
+    detail::trunk_configuration(q, qk);
+    spatial::vec6<T> minus_b = spatial::vec6<T>::Zero();
+    detail::subtract_root_bias(qd, minus_b);
+    const vec3<T> g = detail::root_rotation<T>(q).transpose() * g_.template cast<T>();
+    if constexpr (std::is_same_v<T, S>)
+      detail::tree_aba_kernel<T>(links_, g, qk, qd, tau, qdd, check);
+    else
+      detail::tree_aba_kernel<T>(detail::cast_links<T>(links_), g, qk, qd, tau, qdd, check);
+    qdd.template head<6>() -= minus_b;
+  }
   static double sq(double x) { return x * x; }
   [[noreturn]] void refuse(int i, double d, double scale) const {
     std::ostringstream os;
@@ -351,6 +379,7 @@ class aba_fn : public stage_tag {
   vec3<S> g_;
   std::string name_;
   std::vector<std::string> joints_;
+  bool floating_ = false;
 };
 
 /// The articulated-body forward dynamics of a tree (a chain: `aba(as_tree(chain))`).

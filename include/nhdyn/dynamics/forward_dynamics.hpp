@@ -67,7 +67,8 @@ class forward_dynamics_fn : public stage_tag {
 
  public:
   explicit forward_dynamics_fn(const Model& m, rne_options o = {}, fd_options f = {})
-      : M_(m), rne_(m, o), opt_(o), fd_(f), n_(m.dof()) {
+      : M_(m), rne_(m, o), opt_(o), fd_(f), n_(m.dof()), nq_(m.dof()) {
+    if constexpr (std::is_same_v<Model, tree<S>>) nq_ = m.nq();  // a floating tree's q has one more
     if (f.method != fd_method::crba_ldlt) {
       tree<S> t;
       if constexpr (std::is_same_v<Model, tree<S>>)
@@ -79,6 +80,8 @@ class forward_dynamics_fn : public stage_tag {
     }
   }
   int dof() const { return n_; }
+  /// q's entries: dof() + 1 for a floating tree (model/floating.hpp), else dof().
+  int nq() const { return nq_; }
   fd_options options() const { return fd_; }
 
   /// The 2-norm condition number of M(q) (double).
@@ -134,7 +137,7 @@ class forward_dynamics_fn : public stage_tag {
     requires detail::in_scalar<S, Q, QD, TAU>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                 forward_dynamics_scratch<S, N>& ws, vecN<S, N>& qdd) const {
-    detail::check_size(q, n_, "q");  // before qdd is resized: an aliased input of the wrong size
+    detail::check_size(q, nq_, "q");  // before qdd is resized: an aliased input of the wrong size
     detail::check_size(qd, n_, "qd");
     detail::check_size(tau, n_, "tau");
     detail::check_finite(tau, "tau");
@@ -153,7 +156,7 @@ class forward_dynamics_fn : public stage_tag {
     requires detail::in_scalar<S, Q, QD, TAU> && std::is_same_v<detail::applied_scalar_t<F, Q>, S>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<TAU>& tau,
                 const F& fx, forward_dynamics_scratch<S, N>& ws, vecN<S, N>& qdd) const {
-    detail::check_size(q, n_, "q");
+    detail::check_size(q, nq_, "q");
     detail::check_size(qd, n_, "qd");
     detail::check_size(tau, n_, "tau");
     qdd.resize(n_);  // τ + Q_ext here until the solve
@@ -207,7 +210,7 @@ class forward_dynamics_fn : public stage_tag {
         else
           to = from.template cast<typename To::Scalar>();
       };
-      put(ws.h, rne_(q, qd, vecN<X, N>::Zero(q.size())));
+      put(ws.h, rne_(q, qd, vecN<X, N>::Zero(n_)));
       put(ws.M, M_(q));
     }
     ldlt_factor_into<T, N>(ws.M, ws.factor, "the mass matrix M(q)");
@@ -241,7 +244,7 @@ class forward_dynamics_fn : public stage_tag {
   rne_type rne_;
   rne_options opt_;
   fd_options fd_;
-  int n_;
+  int n_, nq_;
   std::optional<aba_fn<S>> aba_;
   std::optional<friction_fn> friction_;
 };

@@ -4,6 +4,7 @@
 /// (Rigid Body Dynamics Algorithms, 2008; "RBDA"): the specification and the test oracle of
 /// the fast kernels (dynamics/tree.hpp), not what they run. Unchecked inputs; any scalar.
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "../model/tree.hpp"
 #include "../spatial/spatial.hpp"
@@ -104,6 +105,46 @@ matX<T> crba(const tree<S>& t, const vecX<T>& q) {
     }
   }
   return H;
+}
+
+/// A floating tree's (model/floating.hpp) inverse dynamics with its root as one 6-DoF joint,
+/// S = 1₆ (RBDA §4.4, Table 4.1's 6-DoF joint; Pinocchio's free-flyer): the oracle of the
+/// trunk-frame map. q = (p_WB, quaternion, q_joints), v = (v_B, ω_B, q̇), a = (v̇_B, ω̇_B, q̈);
+/// τ = (f_B, n_B, τ_joints). The root's spatial velocity and acceleration in its own axes are
+/// [ω_B; v_B] and [ω̇_B; v̇_B] (a = v̇ in body coordinates: v × v = 0), gravity the world's
+/// fictitious acceleration turned into B, ^BX_W a_g = [0; R_WBᵀ g].
+template <class T, class S>
+vecX<T> rne_floating(const tree<S>& t, const vecX<T>& q, const vecX<T>& v, const vecX<T>& a) {
+  using namespace spatial;
+  const int n = t.dof();
+  std::vector<mat6<T>> X(n);
+  std::vector<vec6<T>> Si(n), vb(n), ab(n), f(n);
+  const Eigen::Quaternion<T> quat(q(6), q(3), q(4), q(5));  // (w, x, y, z)
+  const mat3<T> R_WB = quat.toRotationMatrix();
+  const auto body_inertia = [&](int i) {
+    return inertia<T>(T(t[i].mass), t[i].com.template cast<T>(), t[i].inertia.template cast<T>());
+  };
+  vb[5] << v.template segment<3>(3), v.template head<3>();
+  ab[5] << a.template segment<3>(3), a.template head<3>();
+  ab[5].template tail<3>() -= R_WB.transpose() * t.gravity().template cast<T>();  // a_0 = −a_g
+  f[5] = body_inertia(5) * ab[5] + crf(vb[5]) * body_inertia(5) * vb[5];
+  for (int i = 6; i < n; ++i) {
+    const auto [R, p] = placement(t[i], q(i + 1));
+    X[i] = motion_transform(R, p);
+    Si[i] = motion_subspace<T>(t[i]);
+    const int l = t.parent(i);
+    vb[i] = X[i] * vb[l] + Si[i] * v(i);                                    // (5.7)
+    ab[i] = X[i] * ab[l] + Si[i] * a(i) + crm(vb[i]) * Si[i] * v(i);        // (5.8)
+    f[i] = body_inertia(i) * ab[i] + crf(vb[i]) * body_inertia(i) * vb[i];  // (5.9)
+  }
+  vecX<T> tau(n);
+  for (int i = n - 1; i >= 6; --i) {
+    tau(i) = Si[i].dot(f[i]) + T(t[i].armature) * a(i);                    // (5.11)
+    f[t.parent(i)] += X[i].transpose() * f[i];                             // (5.10)
+  }
+  tau.template head<3>() = f[5].template tail<3>();  // the root's joint: S = 1₆, force first
+  tau.template segment<3>(3) = f[5].template head<3>();
+  return tau;
 }
 
 }  // namespace nhdyn::reference

@@ -36,6 +36,7 @@
 #include "../detail/attributes.hpp"
 #include "../detail/small_buffer.hpp"
 #include "../functional/values.hpp"
+#include "../model/floating.hpp"
 #include "../model/tree.hpp"
 #include "../model/tree_kernel.hpp"
 #include "../spatial/spatial.hpp"
@@ -334,11 +335,13 @@ template <class S>
 class rne_derivatives_fn {
  public:
   explicit rne_derivatives_fn(const tree<S>& t, rne_options o = {})
-      : links_(detail::make_tree_links(t)), g_(t.gravity()), n_(t.dof()), opt_(o) {}
+      : links_(detail::make_tree_links(t)), g_(t.gravity()), n_(t.dof()), opt_(o), floating_(t.floating()) {}
   template <int N>
   explicit rne_derivatives_fn(const chain<S, N>& c, rne_options o = {}) : rne_derivatives_fn(as_tree(c), o) {}
 
   int dof() const { return n_; }
+  /// q's entries: dof() + 1 for a floating tree (model/floating.hpp), else dof().
+  int nq() const { return n_ + (floating_ ? 1 : 0); }
 
   template <class Q, class QD, class QDD>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
@@ -374,15 +377,52 @@ class rne_derivatives_fn {
     if (w.dof() != n_)
       throw input_error("rne_derivatives: the external wrenches are for a model of " + std::to_string(w.dof()) +
                         " joints, this one has " + std::to_string(n_));
+    if (floating_)
+      throw input_error("rne_derivatives: external wrenches on a floating tree are not supported yet "
+                        "(differentiate rne(q, v, a) and the wrenches' joint forces apart)");
   }
   template <class Q, class QD, class QDD, class FX>
   void evaluate_with(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
                      const FX& fx, rne_derivatives_result<S>& out) const {
     check(q, qd, qdd);
+    if (floating_) {
+      floating(q, qd, qdd, links_, out);
+      return;
+    }
     const bool finite =
         opt_.velocity
             ? detail::rne_derivatives_dispatch<S>(links_, g_, opt_.gravity, q, qd, qdd, fx, out)
             : detail::rne_derivatives_dispatch<S>(links_, g_, opt_.gravity, q, vecN<S, dynamic>::Zero(n_), qdd, fx, out);
+    check_result(out, finite);
+  }
+  /// A floating tree (model/floating.hpp): the fixed-base tree's derivatives in the root's
+  /// frame at (q_K, v, a − b(v)), g_K = R_WBᵀ g, then the root's six columns in the tangent
+  /// space of q (q ⊕ δ, δ in the root's frame, as Pinocchio differentiates):
+  ///   ∂τ/∂δ_p = 0 (the root's position enters nothing in its own frame);
+  ///   ∂τ/∂δ_θ = −M_{:,v} [g_K]× (only gravity turns with the root: g_K(δ) = g_K + [g_K]× δ_θ,
+  ///             and gravity acts as the root's linear acceleration −g_K);
+  ///   ∂τ/∂v_root += −M_{:,0…5} ∂b/∂v (the bias inside q̈_K).
+  template <class T, class Q, class QD, class QDD>
+  void floating(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd, const Eigen::MatrixBase<QDD>& qdd,
+                const std::vector<detail::tree_link<T>>& L, rne_derivatives_result<T>& out) const {
+    detail::small_buffer<T, dynamic> qk_s(n_), ak_s(n_);
+    Eigen::Map<vecN<T, dynamic>> qk(qk_s.data(), n_), ak(ak_s.data(), n_);
+    detail::trunk_configuration(q, qk);
+    ak = qdd.template cast<T>();
+    if (opt_.velocity) detail::subtract_root_bias(qd, ak);
+    const vec3<T> g = detail::root_rotation<T>(q).transpose() * g_.template cast<T>();
+    const detail::wrench_forces<T, double> none{};
+    const bool finite =
+        opt_.velocity ? detail::rne_derivatives_dispatch<T>(L, g, opt_.gravity, qk, qd, ak, none, out)
+                      : detail::rne_derivatives_dispatch<T>(L, g, opt_.gravity, qk, vecN<T, dynamic>::Zero(n_), ak, none, out);
+    out.dq.leftCols(3).setZero();
+    if (opt_.gravity) {
+      const mat3<T> G = spatial::skew<T>(g);
+      out.dq.middleCols(3, 3).noalias() = -(out.M.leftCols(3) * G);
+    } else {
+      out.dq.middleCols(3, 3).setZero();
+    }
+    if (opt_.velocity) out.dqd.leftCols(6).noalias() -= out.M.leftCols(6) * detail::root_bias_jacobian<T>(qd);
     check_result(out, finite);
   }
   /// `finite`: the kernel's sum of the matrices' entries was finite, so each is.
@@ -395,7 +435,10 @@ class rne_derivatives_fn {
   }
   template <class Q, class QD, class QDD>
   void check(const Q& q, const QD& qd, const QDD& qdd) const {
-    detail::check_size(q, n_, "q");
+    if (floating_)
+      detail::check_floating_configuration(q, n_ + 1, "q");
+    else
+      detail::check_size(q, n_, "q");
     detail::check_size(qd, n_, "qd");
     detail::check_size(qdd, n_, "qdd");
     detail::check_finite(q, "q");
@@ -411,6 +454,14 @@ class rne_derivatives_fn {
                         W>;
     check(q, qd, qdd);
     rne_derivatives_result<T> out;
+    if (floating_) {
+      if (w) throw input_error("rne_derivatives: external wrenches on a floating tree are not supported yet");
+      if constexpr (std::is_same_v<T, S>)
+        floating(q, qd, qdd, links_, out);
+      else
+        floating(q, qd, qdd, detail::cast_links<T>(links_), out);
+      return out;
+    }
     const auto go = [&](const std::vector<detail::tree_link<T>>& L) {
       const detail::wrench_forces<T, W> fx{w, &L};
       const vec3<T> g = g_.template cast<T>();
@@ -431,6 +482,7 @@ class rne_derivatives_fn {
   vec3<S> g_;
   int n_;
   rne_options opt_;
+  bool floating_ = false;
 };
 
 template <class S>

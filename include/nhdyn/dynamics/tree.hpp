@@ -23,6 +23,7 @@
 #include "../detail/ldlt.hpp"
 #include "../detail/small_buffer.hpp"
 #include "../functional/values.hpp"
+#include "../model/floating.hpp"
 #include "../model/tree_kernel.hpp"
 #include "../spatial/spatial.hpp"
 #include "rne.hpp"
@@ -421,9 +422,12 @@ class tree_rne_fn : public stage_tag {
   static constexpr int size_at_compile_time = dynamic;
 
   explicit tree_rne_fn(const tree<S>& t, rne_options o = {})
-      : links_(detail::make_tree_links(t)), g_(t.gravity()), n_(t.dof()), opt_(o) {}
+      : links_(detail::make_tree_links(t)), g_(t.gravity()), n_(t.dof()), opt_(o), floating_(t.floating()) {}
 
   int dof() const { return n_; }
+  /// q's entries: dof() + 1 for a floating tree (model/floating.hpp), else dof().
+  int nq() const { return n_ + (floating_ ? 1 : 0); }
+  bool floating() const { return floating_; }
   rne_options options() const { return opt_; }
   const vec3<S>& gravity() const { return g_; }
   tree_rne_fn with(rne_options o) const {
@@ -496,14 +500,24 @@ class tree_rne_fn : public stage_tag {
                                               typename QDD::Scalar>>,
                   "v's scalar is the model's and the inputs' promoted scalar");
     detail::check_size(v, n_, "v");
-    detail::check_size(q, n_, "q");
     detail::check_size(qd, n_, "qd");
     detail::check_size(qdd, n_, "qdd");
-    detail::check_finite(q, "q");
     if (opt_.velocity) detail::check_finite(qd, "qd");
     detail::check_finite(qdd, "qdd");
-    const auto run = [&](const std::vector<detail::tree_link<T>>& L) {
-      const vec3<T> g = g_.template cast<T>();
+    if (floating_) {
+      evaluate_floating(q, qd, qdd, v);
+      return;
+    }
+    detail::check_size(q, n_, "q");
+    detail::check_finite(q, "q");
+    run<T>(g_.template cast<T>(), q, qd, qdd, v);
+  }
+  /// v = rne(q, q̇, q̈) − Q_ext(q) into v: below.
+ private:
+  /// The kernel on (q, q̇, q̈) with gravity g.
+  template <class T, class Q, class QD, class QDD, class V>
+  void run(const vec3<T>& g, const Q& q, const QD& qd, const QDD& qdd, V& v) const {
+    const auto go = [&](const std::vector<detail::tree_link<T>>& L) {
       if (opt_.gravity)
         opt_.velocity ? detail::tree_rne_kernel<true, true, T>(L, g, q, qd, qdd, v)
                       : detail::tree_rne_kernel<true, false, T>(L, g, q, qd, qdd, v);
@@ -512,11 +526,28 @@ class tree_rne_fn : public stage_tag {
                       : detail::tree_rne_kernel<false, false, T>(L, g, q, qd, qdd, v);
     };
     if constexpr (std::is_same_v<T, S>)
-      run(links_);
+      go(links_);
     else
-      run(detail::cast_links<T>(links_));
+      go(detail::cast_links<T>(links_));
     detail::check_overflow(v.derived(), "rne");
   }
+  /// A floating tree: the fixed-base tree in the root's frame (model/floating.hpp), q_K and
+  /// q̈_K = a − b(v) in stack scratch, gravity turned into the root's axes.
+  template <class Q, class QD, class QDD, class V>
+  void evaluate_floating(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd,
+                         const Eigen::MatrixBase<QDD>& qdd, Eigen::MatrixBase<V>& v) const {
+    using T = typename V::Scalar;
+    detail::check_floating_configuration(q, n_ + 1, "q");
+    detail::small_buffer<T, dynamic> qk_s(n_), ak_s(n_);
+    Eigen::Map<vecN<T, dynamic>> qk(qk_s.data(), n_), ak(ak_s.data(), n_);
+    detail::trunk_configuration(q, qk);
+    ak = qdd.template cast<T>();
+    if (opt_.velocity) detail::subtract_root_bias(qd, ak);
+    const vec3<T> g = detail::root_rotation<T>(q).transpose() * g_.template cast<T>();
+    run<T>(g, qk, qd, ak, v);
+  }
+
+ public:
   /// v = rne(q, q̇, q̈) − Q_ext(q) into v (applied forces: external wrenches,
   /// dynamics/wrench.hpp): the call's numbers bit for bit, no allocation (Q_ext in stack
   /// scratch) where the applied forces write into storage, as external_wrenches does.
@@ -532,6 +563,7 @@ class tree_rne_fn : public stage_tag {
   vec3<S> g_;
   int n_;
   rne_options opt_;
+  bool floating_ = false;
 };
 
 template <class S>
@@ -578,7 +610,7 @@ template <class S>
 class tree_mass_matrix_fn : public stage_tag {
  public:
   explicit tree_mass_matrix_fn(const tree<S>& t)
-      : links_(detail::make_tree_links(t)), n_(t.dof()) {
+      : links_(detail::make_tree_links(t)), n_(t.dof()), floating_(t.floating()) {
     if constexpr (flatten_kernels<S>) consts_ = detail::make_crba_constants(links_);  // the world-axes kernel's only
     parents_.reserve(links_.size());
     for (const auto& k : links_) parents_.push_back(k.parent);
@@ -612,8 +644,20 @@ class tree_mass_matrix_fn : public stage_tag {
   template <class Q, class T>
   void run(const Eigen::MatrixBase<Q>& q, Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>& H, bool fill) const {
     static_assert(std::is_same_v<T, promote_t<S, typename Q::Scalar>>, "H's scalar is the model's and q's");
+    if (floating_) {  // M of the tree in the root's frame, at q_K (model/floating.hpp): the root's pose drops out
+      detail::check_floating_configuration(q, n_ + 1, "q");
+      detail::small_buffer<T, dynamic> qk_s(n_);
+      Eigen::Map<vecN<T, dynamic>> qk(qk_s.data(), n_);
+      detail::trunk_configuration(q, qk);
+      kernel(qk, H, fill);
+      return;
+    }
     detail::check_size(q, n_, "q");
     detail::check_finite(q, "q");
+    kernel(q, H, fill);
+  }
+  template <class Q, class T>
+  void kernel(const Eigen::MatrixBase<Q>& q, Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>& H, bool fill) const {
     const detail::kernel_input<dynamic, Q> qi(q.derived());  // one kernel per scalar, whatever q's type
     const auto& qv = qi.get();
     if constexpr (flatten_kernels<T> && std::is_same_v<T, S>)
@@ -631,6 +675,7 @@ class tree_mass_matrix_fn : public stage_tag {
   detail::crba_constants<S> consts_;
   int n_;
   std::vector<int> parents_;  ///< each body's parent: what decides M's zeros (mass_matrix_result)
+  bool floating_ = false;
 };
 
 template <class S>
@@ -645,7 +690,7 @@ class tree_bias_fn : public stage_tag {
   explicit tree_bias_fn(const tree<S>& t, rne_options o = {}) : rne_(t, o) {}
   template <class Q, class QD>
   auto operator()(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<QD>& qd) const {
-    return rne_(q, qd, vecN<typename Q::Scalar, dynamic>::Zero(q.size()));
+    return rne_(q, qd, vecN<typename Q::Scalar, dynamic>::Zero(qd.size()));
   }
 
  private:

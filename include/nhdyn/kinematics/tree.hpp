@@ -13,7 +13,9 @@
 #include <vector>
 
 #include "../detail/small_buffer.hpp"
+#include "../model/floating.hpp"
 #include "../model/tree_kernel.hpp"
+#include "../spatial/spatial.hpp"
 #include "kinematics.hpp"
 
 namespace nhdyn {
@@ -24,6 +26,8 @@ class tree_kinematics {
   using scalar_type = S;
   explicit tree_kinematics(const tree<S>& t) : tree_(t), links_(detail::make_tree_links(t)), n_(t.dof()) {}
   int dof() const { return n_; }
+  /// q's entries: dof() + 1 for a floating tree (model/floating.hpp), else dof().
+  int nq() const { return tree_.nq(); }
   const tree<S>& model() const { return tree_; }
 
   /// Poses of the base (entry 0) and of the n body frames (entries 1…n) in the base frame.
@@ -138,11 +142,14 @@ class tree_kinematics {
     std::vector<int> path;
     for (int j = i - 1; j >= 0; j = links_[std::size_t(j)].parent) path.insert(path.begin(), j);
     vec3<T> w = vec3<T>::Zero(), dw = vec3<T>::Zero(), acc = vec3<T>::Zero();  // in K_j
+    // a floating tree (model/floating.hpp): its six root joints at zero with q̈_K = −b(v), the
+    // acceleration at a = 0
+    spatial_bias<T> b(tree_.floating(), qd);
     for (int j : path) {
       const auto k = links_[std::size_t(j)].template cast<T>();
       mat3<T> R;
       vec3<T> p;
-      detail::kernel_placement(k, T(q(j)), R, p);
+      detail::kernel_placement(k, T(joint_position(q, j)), R, p);
       acc = R.transpose() * vec3<T>(acc + dw.cross(p) + w.cross(w.cross(p)));
       w = R.transpose() * w;
       dw = R.transpose() * dw;
@@ -150,8 +157,10 @@ class tree_kinematics {
       if (k.revolute) {
         dw += vec3<T>(w.y() * qdj, -w.x() * qdj, T(0));
         w.z() += qdj;
+        if (j < 6 && b.on) dw.z() += b.qdd(j);
       } else {
         acc += T(2) * qdj * vec3<T>(w.y(), -w.x(), T(0));
+        if (j < 6 && b.on) acc.z() += b.qdd(j);
       }
     }
     const auto& kb = links_[std::size_t(i - 1)];
@@ -169,6 +178,23 @@ class tree_kinematics {
   }
 
  private:
+  /// q̈_K = −b(v) of a floating tree's six root joints (model/floating.hpp); off otherwise.
+  template <class T>
+  struct spatial_bias {
+    bool on;
+    spatial::vec6<T> qdd = spatial::vec6<T>::Zero();
+    template <class QD>
+    spatial_bias(bool floating, const QD& qd) : on(floating) {
+      if (on) detail::subtract_root_bias(qd, qdd);
+    }
+  };
+  /// The position the kernel reads for joint j: q(j), or a floating tree's q_K(j).
+  template <class Q>
+  auto joint_position(const Q& q, int j) const {
+    using T = typename Q::Scalar;
+    if (!tree_.floating()) return T(q(j));
+    return j < 6 ? T(0) : T(q(j + 1));
+  }
   /// Poses of the kernel frames K_0…K_{n−1} in the base frame.
   template <class Q>
   auto kernel_frames(const Eigen::MatrixBase<Q>& q) const {
@@ -179,14 +205,23 @@ class tree_kinematics {
   /// …into K (n poses).
   template <class Q, class T>
   void kernel_frames_into(const Eigen::MatrixBase<Q>& q, pose<T>* K) const {
-    detail::check_size(q, n_, "q");
-    detail::check_finite(q, "q");
+    // a floating tree: the tree in the root's frame at q_K, placed in the world by X_WB
+    pose<T> root;
+    if (tree_.floating()) {
+      detail::check_floating_configuration(q, n_ + 1, "q");
+      root = {detail::root_rotation<T>(q), vec3<T>(T(q(0)), T(q(1)), T(q(2)))};
+    } else {
+      detail::check_size(q, n_, "q");
+      detail::check_finite(q, "q");
+    }
     for (int i = 0; i < n_; ++i) {
       const auto k = links_[std::size_t(i)].template cast<T>();
       mat3<T> R;
       vec3<T> p;
-      detail::kernel_placement(k, T(q(i)), R, p);
-      if (k.parent < 0)
+      detail::kernel_placement(k, T(joint_position(q, i)), R, p);
+      if (k.parent < 0 && tree_.floating())
+        K[i] = {root.R * R, root.p + root.R * p};
+      else if (k.parent < 0)
         K[i] = {R, p};
       else
         K[i] = {K[k.parent].R * R, K[k.parent].p + K[k.parent].R * p};

@@ -71,6 +71,9 @@ struct body {
   S armature{0};
   /// The Coulomb force at q̇ < 0 when it is not −friction (an asymmetric law, as Corke's Puma).
   std::optional<double> friction_negative{};
+  /// One of the six velocity coordinates of a floating base (model/floating.hpp): the tree's
+  /// first six bodies, evaluated at zero in the root link's frame, never a joint of its own.
+  bool free_flyer = false;
 
   /// The friction law the friction stages use (dynamics/friction.hpp).
   joint_friction friction_law() const { return {damping, friction, friction_negative.value_or(-friction)}; }
@@ -86,7 +89,7 @@ struct body {
     return {name,   joint_name, parent, joint, continuous, R_PJ.template cast<U>(), p_PJ.template cast<U>(),
             axis.template cast<U>(), R_JB.template cast<U>(), p_JB.template cast<U>(), U(mass),
             com.template cast<U>(), inertia.template cast<U>(), limits, damping, friction, mimic, U(armature),
-            friction_negative};
+            friction_negative, free_flyer};
   }
 };
 
@@ -194,12 +197,22 @@ class tree {
       if (f.body + 1 < 0 || f.body >= dof() || !detail::is_rotation(f.R) || !finite(f.p))
         throw model_error("model '" + name_ + "', frame '" + f.name +
                           "': body index out of range, a non-rotation, or a non-finite position");
+    validate_floating();
     children_.assign(bodies_.size(), {});
     for (std::size_t i = 0; i < bodies_.size(); ++i)
       if (bodies_[i].parent >= 0) children_[static_cast<std::size_t>(bodies_[i].parent)].push_back(int(i));
   }
 
+  /// The number of velocity coordinates (q̇, q̈ and τ have this many entries), the bodies'.
   int dof() const { return static_cast<int>(bodies_.size()); }
+  /// Whether the root link floats (a free-flyer root, model/floating.hpp): its first six bodies
+  /// are the floating base's velocity coordinates, and q has one entry more than q̇.
+  bool floating() const { return floating_; }
+  /// The number of configuration coordinates: dof() + 1 for a floating tree (the root's unit
+  /// quaternion has four entries for three rotations), else dof().
+  int nq() const { return dof() + (floating_ ? 1 : 0); }
+  /// The number of velocity coordinates: dof().
+  int nv() const { return dof(); }
   const body<S>& operator[](int i) const { return bodies_[static_cast<std::size_t>(i)]; }
   const std::vector<body<S>>& bodies() const { return bodies_; }
   const std::vector<frame<S>>& frames() const { return frames_; }
@@ -250,6 +263,44 @@ class tree {
   tree with_gravity(vec3<S> g) const { return tree(bodies_, std::move(g), name_, validation_, root_, frames_); }
 
  private:
+  /// A floating base is the first six bodies, flagged free_flyer, in the one form the
+  /// algorithms read (model/floating.hpp): root_x, root_y, root_z slide along, root_rx,
+  /// root_ry, root_rz turn about the x, y, z axes of one frame, with identity placements and no
+  /// inertia but the last one's (the root link's); every other body hangs below the root link.
+  void validate_floating() {
+    int flagged = 0;
+    for (const auto& b : bodies_) flagged += b.free_flyer ? 1 : 0;
+    if (flagged == 0) return;
+    const std::string where = "model '" + name_ + "', floating base: ";
+    if (flagged != 6 || dof() < 6)
+      throw model_error(where + std::to_string(flagged) + " bodies are flagged as its coordinates, not 6");
+    for (int i = 0; i < 6; ++i) {
+      const body<S>& b = bodies_[static_cast<std::size_t>(i)];
+      const std::string at = where + "body " + std::to_string(i) + " ('" + b.name + "'): ";
+      vec3<S> e = vec3<S>::Zero();
+      e(i % 3) = S(1);
+      const bool shape = b.free_flyer && b.parent == i - 1 &&
+                         b.joint == (i < 3 ? joint_type::prismatic : joint_type::revolute) &&
+                         detail::value_matrix(b.R_PJ).isIdentity(0) && detail::value_matrix(b.R_JB).isIdentity(0);
+      bool exact = shape;
+      for (int r = 0; r < 3 && exact; ++r)
+        exact = value_of(b.axis(r)) == value_of(e(r)) && value_of(b.p_PJ(r)) == 0 && value_of(b.p_JB(r)) == 0;
+      if (!exact)
+        throw model_error(at + "not in the floating base's form (the first six bodies: root_x, root_y, root_z, "
+                               "root_rx, root_ry, root_rz along and about x, y, z, identity placements)");
+      if (i < 5 && (!is_exact_zero(b.mass) || detail::value_matrix(b.inertia).cwiseAbs().maxCoeff() != 0))
+        throw model_error(at + "carries mass or inertia; only the sixth body (the root link) does");
+      if (!is_exact_zero(b.armature) || b.damping != 0 || b.friction != 0 || b.friction_negative)
+        throw model_error(at + "has armature or friction: a floating base has no drive");
+    }
+    for (int i = 6; i < dof(); ++i)
+      if (bodies_[static_cast<std::size_t>(i)].parent < 5)
+        throw model_error(where + "body '" + bodies_[static_cast<std::size_t>(i)].name + "' is attached to " +
+                          (bodies_[static_cast<std::size_t>(i)].parent < 0 ? std::string("the world")
+                                                                           : "a floating base coordinate") +
+                          ", not below the root link '" + bodies_[5].name + "'");
+    floating_ = true;
+  }
   static bool finite(const auto& M) {
     for (Eigen::Index k = 0; k < M.size(); ++k)
       if (!is_finite_scalar(M.data()[k])) return false;
@@ -283,6 +334,7 @@ class tree {
   std::string name_ = "tree";
   std::string root_ = "base";
   validation validation_{};
+  bool floating_ = false;
 };
 
 namespace detail {
