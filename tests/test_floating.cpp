@@ -15,6 +15,7 @@
 #include <nhdyn/dynamics/tree.hpp>
 #include <nhdyn/kinematics/tree.hpp>
 #include <nhdyn/model/floating.hpp>
+#include <nhdyn/model/lock.hpp>
 #include <nhdyn/scalar/dual.hpp>
 #include <nhdyn/scalar/interval.hpp>
 #include <random>
@@ -287,4 +288,25 @@ TEST_CASE("floating base: other scalars — long double, duals and intervals —
     CHECK(tau(i) <= ti(i).upper());
     CHECK(ti(i).upper() - ti(i).lower() <= 1e-9 * std::max(1.0, std::abs(tau(i))));
   }
+}
+
+TEST_CASE("floating base: locked joints keep the root, and the root's coordinates cannot be locked", "[floating][lock]") {
+  std::mt19937_64 rng(12);
+  const auto t = random_floating(rng, 8);
+  const std::vector<std::pair<std::string, double>> held{{"joint2", 0.4}, {"joint5", -0.3}};
+  const auto lk = lock(t, held);
+  REQUIRE(lk.floating());
+  CHECK(lk.dof() == t.dof() - 2);
+  CHECK(lk.nq() == lk.dof() + 1);
+  const auto m = lock_map_of(t, held);
+  VectorXd q = random_configuration(t, rng);
+  for (const auto& [i, x] : m.locked) q(i + 1) = x;
+  const VectorXd qr = m.reduce(q);
+  REQUIRE(qr.size() == lk.nq());
+  CHECK(rel(m.expand_q(qr), q) == 0);
+  const VectorXd v = random_vec(rng, lk.nv(), 2), a = random_vec(rng, lk.nv(), 3);
+  CHECK(rel(rne(lk)(qr, v, a), m.reduce(VectorXd(rne(t)(q, m.expand(v), m.expand(a))))) <= 1e-12);
+  // "*" locks every joint but the root's six; naming one of them is an error
+  CHECK(lock(t, {{"*", 0.0}}).dof() == 6);
+  CHECK_THROWS_WITH(lock(t, {{"root_rz", 0.0}}), Catch::Contains("coordinate of the floating base"));
 }

@@ -241,8 +241,13 @@ TEST_CASE("URDF errors name the file, the element and the problem", "[urdf][erro
   CHECK_THAT(error(robot(two_links + joint("revolute", "<axis xyz=\"0 0 0\"/><limit effort=\"1\" velocity=\"1\"/>"))),
              Catch::Contains("joint 'j' (line 1): axis is zero"));
   CHECK_THAT(error(robot(two_links + joint("continuous", "<axis xyz=\"0 0 2\"/>"))), Catch::Contains("axis has length 2, not 1"));
-  CHECK_THAT(error(robot(two_links + joint("floating"))), Catch::Contains("type 'floating' is not supported") &&
-                                                               Catch::Contains("\"base\": {\"type\": \"planar\"}"));
+  // a floating joint on the root link floats the robot (below); inside the tree it is refused
+  CHECK_THAT(error(robot(R"(<link name="a"/><link name="b"/><link name="c"/>
+                 <joint name="f" type="fixed"><parent link="a"/><child link="b"/></joint>
+                 <joint name="j" type="floating"><parent link="b"/><child link="c"/></joint>)")),
+             Catch::Contains("joint 'j' (line 3)") && Catch::Contains("'floating' is supported only on the root link"));
+  CHECK_THAT(error(robot(two_links + joint("floating", "<origin xyz=\"0 0 1\"/>"))),
+             Catch::Contains("floating joint's <origin> must be the identity"));
   CHECK_THAT(error(robot(two_links + joint("planar", "<axis xyz=\"0 0 1\"/>"))), Catch::Contains("type 'planar' is not supported"));
   CHECK_THAT(error(robot("<link name=\"a\"/><link name=\"b\"><inertial><mass value=\"-1\"/><inertia ixx=\"1\" ixy=\"0\" "
                          "ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>" +
@@ -404,7 +409,10 @@ TEST_CASE("robot file errors name the file and the field", "[urdf][robot_file][e
   CHECK_THAT(error(R"({"urdf": "../urdf/mobile_manipulator.urdf", "constraint": {"type": "differential_drive"}})"),
              Catch::Contains("needs a planar base"));
   CHECK_THAT(error(R"({"urdf": "../urdf/mobile_manipulator.urdf", "base": {"type": "holonomic"}})"),
-             Catch::Contains("unknown base type 'holonomic' (known: planar)"));
+             Catch::Contains("unknown base type 'holonomic' (known: planar, floating)"));
+  CHECK_THAT(error(R"({"urdf": "../urdf/mobile_manipulator.urdf", "base": {"type": "floating"},
+                      "constraint": {"type": "differential_drive", "x": "a", "y": "b", "heading": "c"}})"),
+             Catch::Contains("constraints on a floating base are not supported yet"));
   CHECK_THAT(error(R"({"urdf": "../urdf/mobile_manipulator.urdf", "base": {"type": "planar"}, "constraint": {"type": "omni"}})"),
              Catch::Contains("unknown constraint type 'omni'"));
   CHECK_THAT(error(R"({"urdf": "../urdf/mobile_manipulator.urdf", "wheels": 2})"), Catch::Contains("unknown field(s) 'wheels'"));
@@ -431,4 +439,56 @@ TEST_CASE("CRBA far from the origin: a planar base's M does not depend on where 
     CHECK((Mfar - M0).norm() <= 1e-12 * M0.norm());
     CHECK((Mfar - reference::crba<double>(r.model, q)).norm() <= 1e-12 * M0.norm());
   }
+}
+
+TEST_CASE("URDF: a floating root joint, or a robot file's floating base, gives a free-flyer tree", "[urdf][floating]") {
+  // a two-link pendulum on a free body, and a frame fixed to the world: the floating joint in
+  // the file, or the same URDF without it and "base": {"type": "floating"} in a robot file
+  const std::string links = R"(
+    <link name="trunk"><inertial><origin xyz="0.05 0 0.02"/><mass value="12"/>
+      <inertia ixx="0.3" ixy="0.01" ixz="0" iyy="0.5" iyz="0" izz="0.6"/></inertial></link>
+    <link name="arm"><inertial><origin xyz="0 0 -0.2"/><mass value="2"/>
+      <inertia ixx="0.03" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.004"/></inertial></link>
+    <link name="hand"><inertial><origin xyz="0 0 -0.1"/><mass value="0.5"/>
+      <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.001"/></inertial></link>
+    <joint name="shoulder" type="revolute"><parent link="trunk"/><child link="arm"/><origin xyz="0.2 0.1 0" rpy="0.3 0 0"/>
+      <axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="50" velocity="5"/></joint>
+    <joint name="elbow" type="continuous"><parent link="arm"/><child link="hand"/><origin xyz="0 0 -0.4"/>
+      <axis xyz="1 0 0"/></joint>)";
+  const std::string with_joint = R"(<robot name="flyer"><link name="world"/><link name="marker"/>
+    <joint name="root_joint" type="floating"><parent link="world"/><child link="trunk"/></joint>
+    <joint name="mark" type="fixed"><parent link="world"/><child link="marker"/><origin xyz="1 2 0"/></joint>)" +
+                                 links + "</robot>";
+  std::vector<std::string> warnings;
+  const tree<double> t = load(with_joint, warnings);
+  CHECK(warnings.empty());
+  REQUIRE(t.floating());
+  CHECK(t.dof() == 8);
+  CHECK(t.nq() == 9);
+  CHECK(t.joint_names() ==
+        std::vector<std::string>{"root_x", "root_y", "root_z", "root_rx", "root_ry", "root_rz", "shoulder", "elbow"});
+  CHECK(t[5].name == "trunk");
+  CHECK(t[5].mass == 12);
+  CHECK(t.root_name() == "world");
+  CHECK(t.find_frame("marker").body == -1);  // fixed to the world, not to the trunk
+  io::urdf_options o;
+  o.floating_base = true;
+  const tree<double> u = io::parse_urdf("<robot name=\"flyer\">" + links + "</robot>", "flyer.urdf", o);
+  REQUIRE(u.floating());
+  std::mt19937_64 rng(11);
+  for (int trial = 0; trial < 5; ++trial) {
+    const VectorXd q = random_configuration(t, rng), v = random_state(rng, 8), a = random_state(rng, 8);
+    const VectorXd tau = rne(t)(q, v, a);
+    CHECK(rel(tau, rne(u)(q, v, a)) == 0);
+    CHECK(rel(tau, reference::rne_floating<double>(t, q, v, a)) < 1e-12);
+    const tree_kinematics<double> kin(t);
+    CHECK((kin.frame(q, "marker").p - Eigen::Vector3d(1, 2, 0)).norm() == 0);
+    CHECK((kin.frame(q, "trunk").p - q.head<3>()).norm() == 0);
+  }
+  // a movable joint on the world beside the floating joint is refused, naming it
+  CHECK_THROWS_WITH(io::parse_urdf(R"(<robot name="r"><link name="world"/><link name="a"/><link name="b"/>
+      <joint name="root_joint" type="floating"><parent link="world"/><child link="a"/></joint>
+      <joint name="j" type="continuous"><parent link="world"/><child link="b"/><axis xyz="0 0 1"/></joint></robot>)"),
+                    Catch::Contains("joint 'j' (line 3)") && Catch::Contains("must hang below the floating link 'a'"));
+  CHECK_THROWS_WITH(io::parse_urdf(with_joint, "flyer.urdf", o), Catch::Contains("give it once"));
 }

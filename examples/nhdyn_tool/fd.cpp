@@ -45,12 +45,12 @@ template <class Model>
 int holonomic(const Model& model, const std::string& name, const nhdyn::terms& t) {
   const auto fd = t.friction ? nhdyn::forward_dynamics(model, t.rne()).with(nhdyn::friction(model, t.coulomb))
                              : nhdyn::forward_dynamics(model, t.rne());
-  const int n = model.dof();
+  const int n = model.dof(), nq = nq_of(model);
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("eta"))
       throw nhdyn::input_error("model '" + name + "' has no constraint: lines are {\"q\", \"qd\", \"tau\"}");
     l.expect_keys(with_f_ext(l, {"q", "qd", "tau"}));
-    const Eigen::VectorXd q = l.vector("q", n), qd = l.vector("qd", n), tau = l.vector("tau", n);
+    const Eigen::VectorXd q = l.vector("q", nq), qd = l.vector("qd", n), tau = l.vector("tau", n);
     const Eigen::VectorXd qdd = l.has("f_ext") ? Eigen::VectorXd(fd(q, qd, tau, nhdyn::external_wrenches(model, wrenches_of(l, model))))
                                                : Eigen::VectorXd(fd(q, qd, tau));
     return ordered_json{{"qdd", to_json(qdd)}};

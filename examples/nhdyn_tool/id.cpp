@@ -58,12 +58,12 @@ int constrained(const Model& model, const C& c, const std::string& name, const n
 /// Lines of a holonomic model: (q, q̇, q̈) -> τ; `id` is rne or rne + friction.
 template <class Model, class Id>
 int holonomic(const Model& model, const std::string& name, const Id& id) {
-  const int n = model.dof();
+  const int n = model.dof(), nq = nq_of(model);
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("eta") || l.has("eta_dot"))
       throw nhdyn::input_error("model '" + name + "' has no constraint: lines are {\"q\", \"qd\", \"qdd\"}");
     l.expect_keys(with_f_ext(l, {"q", "qd", "qdd"}));
-    const Eigen::VectorXd q = l.vector("q", n), qd = l.vector("qd", n), qdd = l.vector("qdd", n);
+    const Eigen::VectorXd q = l.vector("q", nq), qd = l.vector("qd", n), qdd = l.vector("qdd", n);
     const Eigen::VectorXd tau = l.has("f_ext") ? Eigen::VectorXd(id(q, qd, qdd, nhdyn::external_wrenches(model, wrenches_of(l, model))))
                                                : Eigen::VectorXd(id(q, qd, qdd));
     return ordered_json{{"tau", to_json(tau)}};

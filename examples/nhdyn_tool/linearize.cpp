@@ -47,6 +47,7 @@ int constrained(const Model& model, const C& c, const std::string& name, const n
 template <class Model>
 int holonomic(const Model& model, const std::string& name, const nhdyn::terms& t) {
   const auto friction = friction_of(model, t);
+  refuse_floating(model, "linearize");
   const int n = model.dof();
   return run_lines(std::cin, std::cout, [&](const line& l) {
     if (l.has("eta"))

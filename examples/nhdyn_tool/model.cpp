@@ -11,8 +11,15 @@ namespace nhdyn_tool {
 namespace {
 const std::string usage = std::string(R"(nhdyn model --model MODEL [--strict] [--lock 'NAME=POS,...']
   Prints one JSON object describing MODEL:
-    {"name": ..., "dof": n, "joints": [n names, q order], "eta": [m names], "tau": [p names],
-     "k": k, "gravity": [gx, gy, gz]}
+    {"name": ..., "dof": n, "nq": nq, "nv": n, "joints": [n names], "eta": [m names],
+     "tau": [p names], "k": k, "gravity": [gx, gy, gz]}
+  nq is q's length, nv (= dof) that of qd, qdd and tau. They differ for a floating base (a
+  robot file's "base": {"type": "floating"}, or a URDF whose root link floats): q is then
+  (x, y, z, qx, qy, qz, qw, joints) -- the root link's position and unit quaternion -- and
+  qd = (v, omega, joint rates) its velocity in its own frame; "base": "floating" and
+  "q": [nq names] are added, and joints begins with root_x, root_y, root_z, root_rx,
+  root_ry, root_rz (the entries of qd and tau: tau's first six are the root's force and
+  moment in its frame).
   eta names the entries of eta, the independent velocities of a model with a constraint
   ("v" forward speed, "omega" yaw rate, or joint names: the wheel or steering joints of a
   wheels or bicycle constraint, a wheeled_base's choice, the other joints); tau names the
@@ -28,11 +35,24 @@ const std::string usage = std::string(R"(nhdyn model --model MODEL [--strict] [-
   adds base_x, base_y, base_yaw in front.
 )") + std::string(model_options_help);
 
+/// q's entry names: the joints', a floating base's seven (x, y, z and the quaternion) first.
+std::vector<std::string> q_names(const std::vector<std::string>& joints) {
+  std::vector<std::string> q{"root_x", "root_y", "root_z", "root_qx", "root_qy", "root_qz", "root_qw"};
+  q.insert(q.end(), joints.begin() + 6, joints.end());
+  return q;
+}
+
 ordered_json describe(const std::string& name, const std::vector<std::string>& joints, const std::vector<std::string>& eta,
-                      const std::vector<std::string>& tau, int k, const Eigen::Vector3d& g) {
+                      const std::vector<std::string>& tau, int k, const Eigen::Vector3d& g, bool floating = false) {
   ordered_json j;
   j["name"] = name;
   j["dof"] = joints.size();
+  j["nq"] = joints.size() + (floating ? 1 : 0);
+  j["nv"] = joints.size();
+  if (floating) {
+    j["base"] = "floating";
+    j["q"] = q_names(joints);
+  }
   j["joints"] = joints;
   j["eta"] = eta;
   j["tau"] = tau;
@@ -64,7 +84,7 @@ int run(const std::vector<std::string>& args) {
           },
           *model->tree_constraint);
     } else {
-      out = describe(model->name(), joints, joints, joints, 0, t.gravity());
+      out = describe(model->name(), joints, joints, joints, 0, t.gravity(), t.floating());
     }
     if (!model->locked.empty()) {  // what was held, in the full model's q order
       ordered_json held = ordered_json::object();

@@ -91,6 +91,24 @@ int dispatch(const any_model& a, const Constrained& constrained, const Holonomic
   return holonomic(a.dh->chain);
 }
 
+/// q's entries for a model: nq of a tree (one more than dof for a floating base,
+/// model/floating.hpp), dof of a chain.
+template <class Model>
+int nq_of(const Model& m) {
+  if constexpr (requires { m.nq(); })
+    return m.nq();
+  else
+    return m.dof();
+}
+/// Refuses a floating tree in a command that does not take one yet, naming the command.
+template <class Model>
+void refuse_floating(const Model& m, std::string_view command) {
+  if constexpr (requires { m.floating(); })
+    if (m.floating())
+      throw nhdyn::input_error("model '" + m.name() + "' has a floating base, which `nhdyn " + std::string(command) +
+                               "` does not take yet (model, id and fd do)");
+}
+
 /// Calls f(dyn) with dyn the stage in rne's place as the terms say: rne(model, t.rne()), or
 /// rne(model, t.rne()) + friction(model, t.coulomb) (a sum_fn: its `b` is the friction).
 template <class Model, class F>

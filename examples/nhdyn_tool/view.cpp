@@ -133,6 +133,7 @@ page_robot robot_of(const std::string& spec, const std::vector<std::pair<std::st
     }
     return r;
   }
+  refuse_floating(*a.tree, "view");
   r.name = a.name(), r.joints = a.tree->joint_names(), r.locked = a.locked;
   if (a.tree->gravity().norm() > 0) r.up = -a.tree->gravity().normalized();
   if (is_urdf(spec)) {

@@ -99,9 +99,13 @@ class basic_robot_dynamics {
   /// The loaded robot: its tree and its constraint, for the template API (io/robot_file.hpp).
   const io::robot_model& robot() const;
   const std::string& name() const;
-  /// n (the size of q, q̇, q̈, v), m (of η; n without a constraint), k (constraint rows; 0
+  /// n (the size of q̇, q̈, v, and of q but for a floating base), m (of η; n without a constraint), k (constraint rows; 0
   /// without one), p (of τ for inverse_dynamics; m but for wheeled bases with other actuators).
   int dof() const;
+  /// The size of q: dof() + 1 for a floating base (the root's unit quaternion,
+  /// model/floating.hpp), else dof().
+  int nq() const;
+  bool floating() const;
   int m() const;
   int k() const;
   int p() const;
@@ -115,6 +119,13 @@ class basic_robot_dynamics {
   int joint_index(const std::string& joint) const;
   int eta_index(const std::string& name) const;
   int tau_index(const std::string& name) const;
+
+  /// The configuration space (model/floating.hpp): q ⊕ v (a floating root by SE(3)'s
+  /// exponential in its own frame, the joints by +), q1 ⊖ q0, and the neutral q (zeros, the
+  /// identity quaternion).
+  Eigen::VectorXd integrate(vector_arg q, vector_arg v) const;
+  Eigen::VectorXd difference(vector_arg q0, vector_arg q1) const;
+  Eigen::VectorXd neutral_configuration() const;
 
   // The tree as if the base were free: the holonomic dynamics (dynamics/).
   /// v = M(q)q̈ + C(q, q̇)q̇ + g(q) (rne); the second form writes v (resized to n).
@@ -285,6 +296,22 @@ template <class Scalar>
 const std::string& basic_robot_dynamics<Scalar>::name() const { return p_->robot.name; }
 template <class Scalar>
 int basic_robot_dynamics<Scalar>::dof() const { return int(p_->joints.size()); }
+template <class Scalar>
+int basic_robot_dynamics<Scalar>::nq() const { return p_->robot.model.nq(); }
+template <class Scalar>
+bool basic_robot_dynamics<Scalar>::floating() const { return p_->robot.model.floating(); }
+template <class Scalar>
+Eigen::VectorXd basic_robot_dynamics<Scalar>::integrate(vector_arg q, vector_arg v) const {
+  return p_->guarded("integrate", [&] { return Eigen::VectorXd(nhdyn::integrate(p_->robot.model, q, v)); });
+}
+template <class Scalar>
+Eigen::VectorXd basic_robot_dynamics<Scalar>::difference(vector_arg q0, vector_arg q1) const {
+  return p_->guarded("difference", [&] { return Eigen::VectorXd(nhdyn::difference(p_->robot.model, q0, q1)); });
+}
+template <class Scalar>
+Eigen::VectorXd basic_robot_dynamics<Scalar>::neutral_configuration() const {
+  return nhdyn::neutral_configuration(p_->robot.model);
+}
 template <class Scalar>
 int basic_robot_dynamics<Scalar>::m() const { return int(p_->eta.size()); }
 template <class Scalar>

@@ -57,8 +57,9 @@ int main(int argc, char** argv) {
     }
     for (const auto& fr : t.frames()) std::printf("frame %s on %d\n", fr.name.c_str(), fr.body), put(" R", fr.R), put(" p", fr.p);
     const int n = t.dof();
-    Eigen::VectorXd q(n), qd(n), qdd(n);
-    for (int i = 0; i < n; ++i) q(i) = std::sin(0.7 * i + 0.3), qd(i) = std::cos(1.3 * i), qdd(i) = 0.5 - 0.1 * i;
+    Eigen::VectorXd w(n), qd(n), qdd(n);
+    for (int i = 0; i < n; ++i) w(i) = std::sin(0.7 * i + 0.3), qd(i) = std::cos(1.3 * i), qdd(i) = 0.5 - 0.1 * i;
+    const Eigen::VectorXd q = nhdyn::integrate(t, nhdyn::neutral_configuration(t), w);  // w itself on a fixed base
     put("rne", Eigen::VectorXd(nhdyn::rne(t)(q, qd, qdd)));
     if (r.constraint)
       std::visit(

@@ -98,6 +98,16 @@ concept has_depends_on = requires(const C& c, int j) { c.depends_on(j); };
 
 // ---- uniform access: structured products where the constraint has them, dense otherwise.
 
+/// q's entries: the constraint's `nq()` where it has one (a floating base's q has one entry
+/// more than q̇, model/floating.hpp: wheel_contacts), else n.
+template <class C>
+int constraint_nq(const C& c) {
+  if constexpr (requires { c.nq(); })
+    return c.nq();
+  else
+    return c.dof();
+}
+
 /// p, the number of actuators (τ's entries): the constraint's `p()` where it has one, else m.
 template <class C>
 int actuator_count(const C& c) {

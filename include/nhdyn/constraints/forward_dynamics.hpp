@@ -74,7 +74,7 @@ class nh_forward_dynamics_fn : public stage_tag {
   template <class Q>
   auto reduced_inertia(const Eigen::MatrixBase<Q>& q) const {
     using T = promote_t<S, typename Q::Scalar>;
-    detail::check_size(q, c_.dof(), "q");
+    detail::check_size(q, constraint_nq(c_), "q");
     detail::check_finite(q, "q");
     const int m = c_.m();
     matrix<T, M, M> Me(m, m);
@@ -104,7 +104,7 @@ class nh_forward_dynamics_fn : public stage_tag {
   /// forces), by the same steps as evaluate, so the two agree bit for bit.
   template <class Q, class E>
   auto reduced_bias(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta) const {
-    detail::check_size(q, c_.dof(), "q");
+    detail::check_size(q, constraint_nq(c_), "q");
     detail::check_size(eta, c_.m(), "eta");
     detail::check_finite(q, "q");
     detail::check_finite(eta, "eta");
@@ -137,7 +137,7 @@ class nh_forward_dynamics_fn : public stage_tag {
         return kept.eta_dot;
       });
     } else {
-      detail::check_size(q, c_.dof(), "q");
+      detail::check_size(q, constraint_nq(c_), "q");
       const auto Qx = fx.generalized_force(q);
       return solve(q, eta, tau, &Qx);
     }
@@ -160,7 +160,7 @@ class nh_forward_dynamics_fn : public stage_tag {
   template <class Q, class E, class TAU, applied_forces F, class T>
   void evaluate(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<E>& eta, const Eigen::MatrixBase<TAU>& tau,
                 const F& fx, nh_forward_dynamics_result<T, N, M>& out) const {
-    detail::check_size(q, c_.dof(), "q");
+    detail::check_size(q, constraint_nq(c_), "q");
     if constexpr (std::is_same_v<detail::applied_scalar_t<F, Q>, T>) {
       out.applied.resize(c_.dof());
       detail::generalized_force_into(fx, q, out.applied);
@@ -244,7 +244,7 @@ class nh_forward_dynamics_fn : public stage_tag {
     using T0 = promote_t<promote_t<promote_t<S, typename Q::Scalar>, typename E::Scalar>, typename TAU::Scalar>;
     static_assert(std::is_same_v<T, promote_t<T0, typename QX::Scalar>>,
                   "the result's scalar is the model's and the inputs' promoted scalar");
-    detail::check_size(q, c_.dof(), "q");
+    detail::check_size(q, constraint_nq(c_), "q");
     detail::check_size(eta, c_.m(), "eta");
     detail::check_size(tau, actuator_count(c_), "tau");
     detail::check_finite(q, "q");

@@ -47,7 +47,7 @@ struct constraint_scalar<C> {
 /// temporary (q, v) checks v's size only.
 template <class C, class Q, class V>
 void check_projection_input(const C& c, const Q& q, const V& v) {
-  check_size(q, c.dof(), "q");
+  check_size(q, constraint_nq(c), "q");
   check_size(v, c.dof(), "v");
   check_finite(q, "q");
   check_finite(v, "v");
@@ -55,7 +55,7 @@ void check_projection_input(const C& c, const Q& q, const V& v) {
 /// The lift's input checks: sizes n, m, m, then every entry finite.
 template <class C, class Q, class E, class ED>
 void check_reduced_state(const C& c, const Q& q, const E& eta, const ED& eta_dot) {
-  check_size(q, c.dof(), "q");
+  check_size(q, constraint_nq(c), "q");
   check_size(eta, c.m(), "eta");
   check_size(eta_dot, c.m(), "eta_dot");
   check_finite(q, "q");
@@ -294,7 +294,9 @@ class constraint_forces_fn : public stage_tag {
   void lambda_into(const Eigen::MatrixBase<Q>& q, const Eigen::MatrixBase<V>& v, const Tau& tau, L& lambda) const {
     using T = typename L::Scalar;
     constexpr int N = C::n_at_compile_time, K = C::k_at_compile_time;
-    if constexpr (!has_input_map<C, Q> && requires { c_.A_times_into(q, v, lambda); }) {
+    if constexpr (requires { c_.lambda_into(q, v, tau, lambda); }) {
+      c_.lambda_into(q, v, tau, lambda);  // the constraint's own (wheel_contacts: dependent rows)
+    } else if constexpr (!has_input_map<C, Q> && requires { c_.A_times_into(q, v, lambda); }) {
       c_.A_times_into(q, v, lambda);
     } else {
       lambda.resize(c_.k());

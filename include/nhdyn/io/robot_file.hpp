@@ -433,15 +433,23 @@ robot_model parse_robot_file(const std::string& text, const std::string& path, u
   if (j.contains("base")) {
     const json& b = j["base"];
     if (!b.is_object() || !b.contains("type") || !b["type"].is_string())
-      throw model_error(top.field("base") + "expected {\"type\": \"planar\"}");
+      throw model_error(top.field("base") + "expected {\"type\": \"planar\"} or {\"type\": \"floating\"}");
     detail::check_keys(b, {"type"}, {"type"}, top.field("base"), "the base");
-    if (b["type"] != "planar")
-      throw model_error(top.field("base") + "unknown base type '" + b["type"].get<std::string>() + "' (known: planar)");
-    opt.planar_base = true;
+    if (b["type"] == "planar")
+      opt.planar_base = true;
+    else if (b["type"] == "floating")
+      opt.floating_base = true;
+    else
+      throw model_error(top.field("base") + "unknown base type '" + b["type"].get<std::string>() +
+                        "' (known: planar, floating)");
   }
   robot_model out{load_urdf(urdf_path.string(), opt), std::nullopt, ""};
   out.name = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : out.model.name();
   if (j.contains("drives")) out.model = detail::with_drives(out.model, j["drives"], top);
+  if (j.contains("constraint") && out.model.floating())
+    throw model_error(top.field("constraint") +
+                      "constraints on a floating base are not supported yet (the robot floats freely: leave "
+                      "\"constraint\" out)");
   if (j.contains("constraint")) out.constraint = detail::read_robot_constraint(j["constraint"], out.model, top, opt);
   if (j.contains("constraint")) out.constraint_source = j["constraint"];
   out.path = path;

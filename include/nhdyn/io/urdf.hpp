@@ -14,7 +14,10 @@
 ///   gazebo, sensors, safety_controller, calibration.
 /// - Errors (model_error, naming the file and the link or joint): malformed XML, several
 ///   roots, a cycle, a missing parent or child link, NaN or Inf, a negative mass, a zero or
-///   non-unit axis, `floating` and `planar` joints. An inertia that is not physically valid
+///   non-unit axis, `planar` joints, and `floating` joints but the one that may join the root
+///   link (often called "world") to the robot's first link: that robot floats
+///   (model/floating.hpp; its link's six coordinates root_x … root_rz come first, its other
+///   links on the world are frames of the world). An inertia that is not physically valid
 ///   (not positive semi-definite, or principal moments breaking the triangle inequality) is
 ///   used as written with one warning per link, or refused with `urdf_options::strict`.
 /// - Gravity: (0, 0, −9.81) unless the options say otherwise.
@@ -32,6 +35,7 @@
 #include "../config.hpp"
 #include "../detail/compiled_abi.hpp"
 #include "../errors.hpp"
+#include "../model/floating.hpp"
 #include "../model/tree.hpp"
 
 #if NHDYN_DEFINES(NHDYN_PART_IO)  // the parsers' headers: only where the loaders are defined
@@ -60,6 +64,11 @@ struct urdf_options {
   /// joints), the root link's pose on the floor (x, y along the world axes, yaw about world
   /// z). The root link then moves: its own <inertial> and those of links fixed to it count.
   bool planar_base = false;
+  /// A floating base in front of the URDF's joints (model/floating.hpp): the root link moves
+  /// freely, q = (x, y, z, qx, qy, qz, qw, the URDF's joints), v = (v_B, ω_B, the joints'
+  /// rates). A URDF whose root link is joined to the world by a `floating` joint floats too,
+  /// without this option.
+  bool floating_base = false;
 };
 
 /// A URDF document (its text) as a tree. `where` names it in messages (a file name).
@@ -226,6 +235,26 @@ tree<double> parse_urdf(const std::string& text, const std::string& where, urdf_
     }
     where_is[root->name] = {2, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
   }
+  // A floating base: six bodies in front (model/floating.hpp), the last the floating link,
+  // which is the root link (the option) or the child of the root's floating joint (the file).
+  const detail::joint_element* root_floating = nullptr;
+  for (const auto& j : doc.joints)
+    if (j.parent == root->name && model->getJoint(j.name) && model->getJoint(j.name)->type == urdf::Joint::FLOATING) {
+      if (root_floating)
+        throw model_error(at + "joints '" + root_floating->name + "' and '" + j.name +
+                          "' both float on the root link '" + root->name + "': a robot has one floating base");
+      root_floating = &j;
+    }
+  if (root_floating && (opt.floating_base || opt.planar_base))
+    throw model_error(at + "joint '" + root_floating->name + "' (line " + std::to_string(root_floating->line) +
+                      ") is a floating joint, and the robot file gives the base too (\"base\"): give it once");
+  const bool floating = opt.floating_base || root_floating;
+  if (opt.floating_base && opt.planar_base) throw model_error(at + "a base cannot be both planar and floating");
+  if (floating) {
+    const std::string link = root_floating ? root_floating->child : root->name;
+    bodies = free_flyer_bodies<double>(link);
+    where_is[link] = {5, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
+  }
 
   // A link's own inertial, checked, in the frame of the body it joins.
   const auto add_inertial = [&](const urdf::Link& L, const placed& pl) {
@@ -281,9 +310,17 @@ tree<double> parse_urdf(const std::string& text, const std::string& where, urdf_
         add_inertial(*L, where_is[link_name]);
         continue;
       case urdf::Joint::FLOATING:
+        if (je == root_floating) {
+          if ((R_o - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-12 || p_o.cwiseAbs().maxCoeff() > 1e-12)
+            throw model_error(at + here + "a floating joint's <origin> must be the identity: q places the link '" +
+                              link_name + "' in the world directly");
+          add_inertial(*L, where_is[link_name]);
+          continue;
+        }
+        throw model_error(at + here + "type 'floating' is supported only on the root link (the robot's floating "
+                          "base, docs/model-format.md), not inside the tree under '" + je->parent + "'");
       case urdf::Joint::PLANAR:
-        throw model_error(at + here + "type '" + (J->type == urdf::Joint::FLOATING ? "floating" : "planar") +
-                          "' is not supported: a mobile base is described in a robot file beside the URDF "
+        throw model_error(at + here + "type 'planar' is not supported: a mobile base is described in a robot file beside the URDF "
                           "(\"base\": {\"type\": \"planar\"}, docs/model-format.md), not by a joint in it");
       case urdf::Joint::REVOLUTE:
       case urdf::Joint::CONTINUOUS:
@@ -318,6 +355,9 @@ tree<double> parse_urdf(const std::string& text, const std::string& where, urdf_
       os << at << here << "axis has length " << len << ", not 1";
       throw model_error(os.str());
     }
+    if (floating && (parent.body) < 0)
+      throw model_error(at + here + "a movable joint on the world link '" + je->parent +
+                        "' of a floating robot: every moving link must hang below the floating link '" + bodies[5].name + "'");
     body<double> b;
     b.name = link_name;
     b.joint_name = je->name;
@@ -346,7 +386,7 @@ tree<double> parse_urdf(const std::string& text, const std::string& where, urdf_
     where_is[link_name] = {static_cast<int>(bodies.size()) - 1, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
     add_inertial(*L, where_is[link_name]);
   }
-  if (opt.planar_base) add_inertial(*root, where_is[root->name]);
+  if (opt.planar_base || opt.floating_base) add_inertial(*root, where_is[root->name]);
   if (visits.size() != model->links_.size())
     for (const auto& [name, l] : model->links_)
       if (!visits.count(name)) throw model_error(at + "link '" + name + "'" + line_of_link(name) + " is not connected to the root '" + root->name + "'");
@@ -355,8 +395,8 @@ tree<double> parse_urdf(const std::string& text, const std::string& where, urdf_
   validation v;
   v.triangle_inequality = false;  // checked per link above (warning or error)
   v.positive_semidefinite = false;
-  return tree<double>(std::move(bodies), opt.gravity, model->getName(), v, opt.planar_base ? "world" : root->name,
-                      std::move(frames));
+  return tree<double>(std::move(bodies), opt.gravity, model->getName(), v,
+                      opt.planar_base || opt.floating_base ? "world" : root->name, std::move(frames));
 }
 
 template <class>

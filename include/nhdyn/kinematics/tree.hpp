@@ -170,6 +170,43 @@ class tree_kinematics {
     return out;
   }
 
+  /// The joints' frames at q, once for several points: entry j's axes and origin in the base
+  /// frame (world), its third column the joint's axis z_j through the origin o_j (the kernel
+  /// frame, model/tree_kernel.hpp). A floating tree's are placed by the root's pose.
+  template <class Q>
+  auto joint_frames(const Eigen::MatrixBase<Q>& q) const {
+    return kernel_frames(q);
+  }
+  /// Body frame i (0…n, 0 the base) from joint_frames(q).
+  template <class T>
+  pose<T> body_pose(const std::vector<pose<T>>& K, int i) const {
+    check_body(i);
+    if (i == 0) return {};
+    const auto& kb = links_[std::size_t(i - 1)];
+    return {K[std::size_t(i - 1)].R * kb.R_KB.template cast<T>(),
+            K[std::size_t(i - 1)].p + K[std::size_t(i - 1)].R * kb.p_KB.template cast<T>()};
+  }
+  /// The translational Jacobian (3 × n, base frame) of the point of body i (0…n) that is at
+  /// p_W (base frame, any scalar: a point that moves on the body, as a wheel's contact point
+  /// does) from joint_frames(q): column j is z_j × (p_W − o_j) for a revolute joint j on i's
+  /// path, z_j for a prismatic one, zero otherwise.
+  template <class T, class P>
+  Eigen::Matrix<promote_t<T, typename P::Scalar>, 3, Eigen::Dynamic> point_jacobian(const std::vector<pose<T>>& K, int i,
+                                                                                    const Eigen::MatrixBase<P>& p_W) const {
+    using R = promote_t<T, typename P::Scalar>;
+    check_body(i);
+    Eigen::Matrix<R, 3, Eigen::Dynamic> J = Eigen::Matrix<R, 3, Eigen::Dynamic>::Zero(3, n_);
+    const vec3<R> p = p_W.template cast<R>();
+    for (int j = i - 1; j >= 0; j = links_[std::size_t(j)].parent) {
+      const vec3<R> z = K[std::size_t(j)].R.col(2).template cast<R>();
+      if (links_[std::size_t(j)].revolute)
+        J.col(j) = z.cross(vec3<R>(p - K[std::size_t(j)].p.template cast<R>()));
+      else
+        J.col(j) = z;
+    }
+    return J;
+  }
+
   /// 1-based body index of a body or frame name (0: the base) and the point on that body of
   /// the frame's origin, for the index forms above.
   std::pair<int, vec3<S>> locate(const std::string& name) const {

@@ -158,22 +158,42 @@ struct lock_map {
   int full_dof = 0;                            ///< the full tree's joints
   std::vector<int> kept;                       ///< full-tree indices of the kept joints (the reduced q order)
   std::vector<std::pair<int, double>> locked;  ///< (full-tree index, position) of the locked joints
+  /// A floating tree's (model/floating.hpp): its q has one entry more than its joint vectors,
+  /// the root's quaternion, which reduce and expand_q carry over.
+  bool floating = false;
 
   /// The reduced tree's joints.
   int dof() const { return static_cast<int>(kept.size()); }
 
-  /// The kept entries of a full-tree joint vector (q, q̇, q̈, τ), in order.
+  /// The kept entries of a full-tree joint vector (q̇, q̈, τ; or q), in order. A floating
+  /// tree's q (full_dof + 1 entries) keeps its seven root entries.
   template <class V>
   Eigen::Matrix<typename V::Scalar, Eigen::Dynamic, 1> reduce(const Eigen::MatrixBase<V>& full) const {
-    detail::check_size(full, full_dof, "full-tree joint vector");
-    Eigen::Matrix<typename V::Scalar, Eigen::Dynamic, 1> out(dof());
-    for (int k = 0; k < dof(); ++k) out(k) = full(kept[static_cast<std::size_t>(k)]);
+    const int extra = floating && full.size() == full_dof + 1 ? 1 : 0;
+    detail::check_size(full, full_dof + extra, "full-tree joint vector");
+    Eigen::Matrix<typename V::Scalar, Eigen::Dynamic, 1> out(dof() + extra);
+    for (int k = 0; k < dof(); ++k) {
+      const int i = kept[static_cast<std::size_t>(k)];
+      out(k + (extra && k >= 6 ? 1 : 0)) = full(i + (extra && i >= 6 ? 1 : 0));
+    }
+    if (extra) out(6) = full(6);
     return out;
   }
   /// The full-tree positions of reduced-tree positions q: the locked joints at their positions.
+  /// A floating tree's q has dof() + 1 entries, and so has the result.
   template <class V>
   Eigen::Matrix<typename V::Scalar, Eigen::Dynamic, 1> expand_q(const Eigen::MatrixBase<V>& q) const {
     using T = typename V::Scalar;
+    if (floating) {
+      detail::check_size(q, dof() + 1, "reduced-tree configuration");
+      Eigen::Matrix<T, Eigen::Dynamic, 1> qv(dof());  // q without qw, as a joint vector
+      qv << q.head(6), q.tail(dof() - 6);
+      const Eigen::Matrix<T, Eigen::Dynamic, 1> e = expand(qv);
+      Eigen::Matrix<T, Eigen::Dynamic, 1> out(full_dof + 1);
+      out << e.head(6), q(6), e.tail(full_dof - 6);
+      for (const auto& [i, x] : locked) out(i + 1) = T(x);
+      return out;
+    }
     Eigen::Matrix<T, Eigen::Dynamic, 1> out = expand(q);
     for (const auto& [i, x] : locked) out(i) = T(x);
     return out;
@@ -205,6 +225,11 @@ lock_map lock_map_of(const tree<S>& t, const std::vector<std::pair<std::string, 
       throw model_error(at + "the position of '" + pattern + "' is not finite (" + detail::lock_number(position) + ")");
     bool any = false;
     for (int i = 0; i < n; ++i) {
+      if (t[i].free_flyer) {  // a floating base's coordinates are not joints: a glob passes them by
+        if (pattern == t[i].joint_name)
+          throw model_error(at + "'" + pattern + "' is a coordinate of the floating base, which cannot be locked");
+        continue;
+      }
       if (!detail::glob_match(pattern, t[i].joint_name)) continue;
       any = true;
       int& owner = by[static_cast<std::size_t>(i)];
@@ -216,13 +241,15 @@ lock_map lock_map_of(const tree<S>& t, const std::vector<std::pair<std::string, 
     }
     if (!any) {
       std::string known;
-      for (int i = 0; i < n; ++i) known += (i ? ", " : "") + t[i].joint_name;
+      for (int i = 0; i < n; ++i)
+        if (!t[i].free_flyer) known += (known.empty() ? "" : ", ") + t[i].joint_name;
       throw model_error(at + "'" + pattern + "' matches no movable joint (movable joints: " +
                         (known.empty() ? std::string("none") : known) + ")");
     }
   }
   lock_map m;
   m.full_dof = n;
+  m.floating = t.floating();
   for (int i = 0; i < n; ++i) {
     const int e = by[static_cast<std::size_t>(i)];
     if (e < 0)
@@ -262,6 +289,8 @@ tree<S> lock_indices(const tree<S>& t, const std::vector<std::pair<int, double>>
                         detail::lock_number(x) + ")");
     if (held[static_cast<std::size_t>(i)])
       throw model_error(at + "joint '" + t[i].joint_name + "' is locked twice");
+    if (t[i].free_flyer)
+      throw model_error(at + "'" + t[i].joint_name + "' is a coordinate of the floating base, which cannot be locked");
     held[static_cast<std::size_t>(i)] = x;
   }
 

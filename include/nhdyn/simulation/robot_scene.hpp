@@ -134,6 +134,8 @@ scene_setup setup_scene(const Spec& s) {
     return apply_terms(out);
   }
   const io::robot_model r = io::lock_robot(io::load_robot(s.robot), s.locked, where + "field 'locked': ");
+  if (r.model.floating())
+    throw input_error(where + "field 'robot': '" + r.name + "' has a floating base, which scenes do not take yet");
   const int n = r.model.dof(), m = n - r.k();
   out.robot = r.name;
   detail::check_reference(s, n);
